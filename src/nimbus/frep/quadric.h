@@ -1,0 +1,53 @@
+#pragma once
+// The paper's second-order function (eq. 3):
+//   F = A11 x² + A22 y² + A33 z² + A12 xy + A13 xz + A23 yz + A14 x + A24 y + A34 z + A44
+// inside where F > 0. No factor 2 on the cross terms.
+
+#include <array>
+
+#include "nimbus/math/mat4.h"
+#include "nimbus/math/ray.h"
+#include "nimbus/math/vec3.h"
+
+namespace nimbus {
+
+struct Quadric {
+  // A11 A22 A33 A12 A13 A23 A14 A24 A34 A44, in the paper's order.
+  std::array<double, 10> a{};
+
+  double eval(const Vec3& p) const {
+    return p.x * (a[0] * p.x + a[3] * p.y + a[4] * p.z + a[6]) +
+           p.y * (a[1] * p.y + a[5] * p.z + a[7]) + p.z * (a[2] * p.z + a[8]) + a[9];
+  }
+  Vec3 gradient(const Vec3& p) const {
+    return {2 * a[0] * p.x + a[3] * p.y + a[4] * p.z + a[6],
+            2 * a[1] * p.y + a[3] * p.x + a[5] * p.z + a[7],
+            2 * a[2] * p.z + a[4] * p.x + a[5] * p.y + a[8]};
+  }
+  // The quadratic part alone, i.e. F's second-order term at direction d.
+  double quadratic_form(const Vec3& d) const {
+    return a[0] * d.x * d.x + a[1] * d.y * d.y + a[2] * d.z * d.z + a[3] * d.x * d.y +
+           a[4] * d.x * d.z + a[5] * d.y * d.z;
+  }
+};
+
+// F along a ray: F(o + t d) = a t² + b t + c.
+struct RayQuadratic {
+  double a = 0, b = 0, c = 0;
+  double at(double t) const { return (a * t + b) * t + c; }
+  double derivative(double t) const { return 2 * a * t + b; }
+};
+
+inline RayQuadratic restrict_to_ray(const Quadric& q, const Ray& r) {
+  return {q.quadratic_form(r.d), dot(q.gradient(r.o), r.d), q.eval(r.o)};
+}
+
+// The symmetric 4x4 matrix A with F = pᵀ A p on homogeneous p = (x, y, z, 1).
+Mat4 to_matrix(const Quadric& q);
+Quadric from_matrix(const Mat4& A);
+
+// The quadric of the transformed object: F'(x) = F(M⁻¹ x), i.e. A' = M⁻ᵀ A M⁻¹.
+// Only the coefficients change (paper §2.1). M must be invertible.
+Quadric transformed(const Quadric& q, const Mat4& M);
+
+}  // namespace nimbus

@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# Sets up (Debian packages), builds nimbus in Release and runs the whole test suite.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash tools/setup.sh
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j"$(nproc)"
+ctest --test-dir build --output-on-failure -j"$(nproc)"
