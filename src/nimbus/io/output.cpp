@@ -1,0 +1,53 @@
+#include "nimbus/io/output.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <stdexcept>
+
+#include "nimbus/io/exr.h"
+#include "nimbus/io/png.h"
+
+namespace nimbus {
+namespace {
+
+enum class Format { Exr, Png };
+
+Format format_of(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".exr") return Format::Exr;
+  if (ext == ".png") return Format::Png;
+  throw std::runtime_error(path + ": unknown image format (use .exr or .png)");
+}
+
+}  // namespace
+
+void write_image(const std::string& path, const Image& image) {
+  switch (format_of(path)) {
+    case Format::Exr:
+      write_exr(path, image);
+      return;
+    case Format::Png:
+      write_png(path, image);
+      return;
+  }
+}
+
+void check_output_path(const std::string& path) {
+  format_of(path);
+  namespace fs = std::filesystem;
+  const fs::path parent = fs::path(path).parent_path();
+  const fs::path dir = parent.empty() ? fs::path(".") : parent;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    throw std::runtime_error(path + ": directory " + dir.string() + " does not exist");
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw std::runtime_error(path + ": directory " + dir.string() + " is not writable");
+  if (fs::is_directory(path, ec)) throw std::runtime_error(path + ": is a directory");
+}
+
+}  // namespace nimbus
