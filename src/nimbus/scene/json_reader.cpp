@@ -1,0 +1,219 @@
+#include "nimbus/scene/json_reader.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace nimbus {
+namespace {
+
+std::string describe(const Range& r) {
+  const char* open_lo = r.lo_open ? "(" : "[";
+  const char* close_hi = r.hi_open ? ")" : "]";
+  if (r.lo && r.hi) return fmt::format("must be in {}{}, {}{}", open_lo, *r.lo, *r.hi, close_hi);
+  if (r.lo) return fmt::format("must be {} {}", r.lo_open ? ">" : ">=", *r.lo);
+  return fmt::format("must be {} {}", r.hi_open ? "<" : "<=", *r.hi);
+}
+
+bool contains(const Range& r, double x) {
+  if (r.lo && (r.lo_open ? !(x > *r.lo) : !(x >= *r.lo))) return false;
+  if (r.hi && (r.hi_open ? !(x < *r.hi) : !(x <= *r.hi))) return false;
+  return true;
+}
+
+// Levenshtein distance, for suggesting the key a typo was meant to be.
+size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1] ? 1 : 0)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// A suggestion only when the typo is small compared with the words.
+bool is_likely_typo(std::string_view typed, std::string_view meant) {
+  const size_t d = edit_distance(typed, meant);
+  return d <= 2 && d < typed.size() && d < meant.size();
+}
+
+const char* type_name(const nlohmann::json& j) {
+  switch (j.type()) {
+    case nlohmann::json::value_t::null:
+      return "null";
+    case nlohmann::json::value_t::object:
+      return "an object";
+    case nlohmann::json::value_t::array:
+      return "an array";
+    case nlohmann::json::value_t::string:
+      return "a string";
+    case nlohmann::json::value_t::boolean:
+      return "a boolean";
+    default:
+      return "a number";
+  }
+}
+
+}  // namespace
+
+std::string child_pointer(const std::string& pointer, std::string_view key) {
+  std::string out = pointer + "/";
+  for (char c : key) {
+    if (c == '~')
+      out += "~0";
+    else if (c == '/')
+      out += "~1";
+    else
+      out += c;
+  }
+  return out;
+}
+
+void JsonValue::fail(std::string_view problem) const {
+  std::string origin = origin_->source;
+  for (const auto& o : origin_->overrides) {
+    const bool inside = pointer_ == o.pointer || (pointer_.rfind(o.pointer + "/", 0) == 0);
+    if (inside) origin = o.flag;  // the last override of a value is the one in effect
+  }
+  throw SceneError(fmt::format("{}: {}: {}", origin, pointer_.empty() ? "/" : pointer_, problem));
+}
+
+void JsonValue::check(double x, const Range& range) const {
+  if (!contains(range, x)) fail(describe(range));
+}
+
+double JsonValue::number(const Range& range) const {
+  if (!json_->is_number()) fail(fmt::format("expected a number, not {}", type_name(*json_)));
+  const double x = json_->get<double>();
+  if (!std::isfinite(x)) fail("must be finite");
+  check(x, range);
+  return x;
+}
+
+int JsonValue::integer(const Range& range) const {
+  if (!json_->is_number_integer())
+    fail(fmt::format("expected an integer, not {}",
+                     json_->is_number() ? "a fraction" : type_name(*json_)));
+  // Unsigned values above INT64_MAX compare correctly as doubles against the int range below.
+  const double x = json_->is_number_unsigned() ? static_cast<double>(json_->get<uint64_t>())
+                                               : static_cast<double>(json_->get<int64_t>());
+  check(x, range);
+  check(x, between(std::numeric_limits<int>::min(), std::numeric_limits<int>::max()));
+  return static_cast<int>(x);
+}
+
+uint64_t JsonValue::unsigned_integer() const {
+  if (!json_->is_number_integer())
+    fail(fmt::format("expected an integer, not {}",
+                     json_->is_number() ? "a fraction" : type_name(*json_)));
+  if (!json_->is_number_unsigned()) fail("must be >= 0");
+  return json_->get<uint64_t>();
+}
+
+bool JsonValue::boolean() const {
+  if (!json_->is_boolean()) fail(fmt::format("expected true or false, not {}", type_name(*json_)));
+  return json_->get<bool>();
+}
+
+std::string JsonValue::string() const {
+  if (!json_->is_string()) fail(fmt::format("expected a string, not {}", type_name(*json_)));
+  return json_->get<std::string>();
+}
+
+Vec3 JsonValue::vec3(const Range& range) const {
+  if (!json_->is_array() || json_->size() != 3) fail("expected an array of 3 numbers");
+  Vec3 v;
+  for (int i = 0; i < 3; ++i)
+    v[i] = JsonValue((*json_)[i], pointer_ + "/" + std::to_string(i), *origin_).number(range);
+  return v;
+}
+
+Vec3 JsonValue::direction() const {
+  const Vec3 v = vec3();
+  if (dot(v, v) == 0) fail("must be a nonzero vector");
+  return v;
+}
+
+Rgb JsonValue::rgb(const Range& range) const {
+  if (json_->is_number()) return Rgb(number(range));
+  if (!json_->is_array() || json_->size() != 3) fail("expected a number or an array of 3 numbers");
+  const Vec3 v = vec3(range);
+  return Rgb({v.x, v.y, v.z});
+}
+
+std::vector<JsonValue> JsonValue::array() const {
+  if (!json_->is_array()) fail(fmt::format("expected an array, not {}", type_name(*json_)));
+  std::vector<JsonValue> out;
+  for (size_t i = 0; i < json_->size(); ++i)
+    out.emplace_back((*json_)[i], pointer_ + "/" + std::to_string(i), *origin_);
+  return out;
+}
+
+size_t JsonValue::choice(std::string_view noun, const std::vector<std::string_view>& names) const {
+  const std::string s = string();
+  size_t i = 0;
+  for (std::string_view name : names) {
+    if (s == name) return i;
+    ++i;
+  }
+  fail(fmt::format("unknown {} \"{}\" (expected one of: {})", noun, s, fmt::join(names, ", ")));
+}
+
+JsonObject::JsonObject(const JsonValue& value) : value_(value) {
+  if (!value.json().is_object())
+    value.fail(fmt::format("expected an object, not {}", type_name(value.json())));
+}
+
+std::optional<JsonValue> JsonObject::optional(const std::string& key) {
+  known_.insert(key);
+  const auto it = value_.json().find(key);
+  if (it == value_.json().end()) return std::nullopt;
+  return JsonValue(*it, child_pointer(value_.pointer(), key), value_.origin());
+}
+
+JsonValue JsonObject::required(const std::string& key) {
+  if (auto v = optional(key)) return *v;
+  // A present, unasked-for key spelt almost like the missing one is most likely a typo of it.
+  for (const auto& [present, json] : value_.json().items())
+    if (!known_.count(present) && is_likely_typo(present, key))
+      JsonValue(json, child_pointer(value_.pointer(), present), value_.origin())
+          .fail(fmt::format("unknown key (did you mean \"{}\"?)", key));
+  JsonValue(value_.json(), child_pointer(value_.pointer(), key), value_.origin())
+      .fail("required key is missing");
+}
+
+std::vector<std::pair<std::string, JsonValue>> JsonObject::entries() {
+  std::vector<std::pair<std::string, JsonValue>> out;
+  for (const auto& [key, json] : value_.json().items()) {
+    known_.insert(key);
+    out.emplace_back(key, JsonValue(json, child_pointer(value_.pointer(), key), value_.origin()));
+  }
+  return out;
+}
+
+void JsonObject::finish(std::string_view context) const {
+  for (const auto& [key, json] : value_.json().items()) {
+    if (known_.count(key)) continue;
+    std::string problem = "unknown key";
+    if (!context.empty()) problem += fmt::format(" {}", context);
+    size_t best = std::numeric_limits<size_t>::max();
+    std::string_view suggestion;
+    for (const std::string& k : known_) {
+      const size_t d = edit_distance(key, k);
+      if (d < best) best = d, suggestion = k;
+    }
+    if (is_likely_typo(key, suggestion))
+      problem += fmt::format(" (did you mean \"{}\"?)", suggestion);
+    JsonValue(json, child_pointer(value_.pointer(), key), value_.origin()).fail(problem);
+  }
+}
+
+}  // namespace nimbus

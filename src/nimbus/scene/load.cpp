@@ -1,0 +1,510 @@
+#include "nimbus/scene/load.h"
+
+#include <fmt/format.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "nimbus/frep/primitives.h"
+
+namespace nimbus {
+namespace {
+
+// Below this |det| a transform squashes space so much that the transformed quadric's
+// coefficients (which use its inverse) are meaningless.
+constexpr double kMinDeterminant = 1e-12;
+
+// In the order of SurfaceDesc::Type, so that an index is the enumerator.
+const std::vector<std::string_view> kSurfaceTypes = {"none", "diffuse", "dielectric", "emissive"};
+
+std::string string_choice(const JsonValue& v, std::string_view noun,
+                          const std::vector<std::string_view>& names) {
+  return std::string(names[v.choice(noun, names)]);
+}
+
+Mat4 read_transform(const JsonValue& v) {
+  Mat4 m = Mat4::identity();
+  for (const JsonValue& step_value : v.array()) {
+    JsonObject step(step_value);
+    const auto translate = step.optional("translate");
+    const auto rotate = step.optional("rotate");
+    const auto scale = step.optional("scale");
+    step.finish();
+    if (step_value.json().size() != 1)
+      step.fail(R"(expected exactly one of "translate", "rotate", "scale")");
+    Mat4 s;
+    if (translate) {
+      s = Mat4::translate(translate->vec3());
+    } else if (rotate) {
+      JsonObject r(*rotate);
+      const Vec3 axis = r.required("axis").direction();
+      const double degrees = r.required("degrees").number();
+      r.finish();
+      s = Mat4::rotate(axis, degrees);
+    } else if (scale->json().is_number()) {
+      const double k = scale->number();
+      if (k == 0) scale->fail("must be nonzero");
+      s = Mat4::scale({k, k, k});
+    } else {
+      const Vec3 k = scale->vec3();
+      for (int i = 0; i < 3; ++i)
+        if (k[i] == 0) scale->array()[i].fail("must be nonzero");
+      s = Mat4::scale(k);
+    }
+    m = s * m;  // steps apply in the listed order
+  }
+  const double det = determinant(m);
+  if (!(std::abs(det) > kMinDeterminant) || !std::isfinite(det))
+    v.fail(fmt::format("degenerate transform (determinant {})", det));
+  return m;
+}
+
+class Loader {
+ public:
+  explicit Loader(const JsonValue& document) : root_(document) {}
+
+  SceneDesc load() {
+    // Every top-level key is asked for before any is read, so that a misspelt section is
+    // reported as such rather than as a missing one.
+    const auto film = root_.optional("film");
+    const auto camera = root_.optional("camera");
+    const auto integrator = root_.optional("integrator");
+    const auto lights = root_.optional("lights");
+    const auto shapes = root_.optional("shapes");
+    const auto media = root_.optional("media");
+    const auto objects = root_.optional("objects");
+    root_.finish();
+
+    SceneDesc scene;
+    scene.source = root_.value().origin().source;
+    if (film) scene.film = read_film(*film);
+    scene.camera = read_camera(camera ? *camera : root_.required("camera"));
+    if (integrator) scene.integrator = read_integrator(*integrator);
+    if (lights)
+      for (const JsonValue& l : lights->array()) scene.lights.push_back(read_light(l));
+    if (shapes) {
+      // Every named shape is built, used or not, so that errors do not hide in unused ones.
+      shapes_.emplace(*shapes);
+      for (const auto& [name, value] : shapes_->entries()) named_shape(name, value);
+    }
+    if (media) {
+      JsonObject table(*media);
+      for (const auto& [name, value] : table.entries()) {
+        media_index_[name] = static_cast<int>(scene.media.size());
+        scene.media.push_back(read_medium(name, value));
+      }
+    }
+    if (objects)
+      for (const JsonValue& o : objects->array()) scene.objects.push_back(read_object(o));
+    return scene;
+  }
+
+ private:
+  static FilmDesc read_film(const JsonValue& v) {
+    JsonObject o(v);
+    FilmDesc f;
+    if (auto w = o.optional("width")) f.width = w->integer(between(1, 16384));
+    if (auto h = o.optional("height")) f.height = h->integer(between(1, 16384));
+    o.finish();
+    return f;
+  }
+
+  static CameraDesc read_camera(const JsonValue& v) {
+    JsonObject o(v);
+    CameraDesc c;
+    if (auto t = o.optional("type"))
+      c.type = t->choice("camera type", {"perspective", "orthographic"}) == 0
+                   ? CameraDesc::Type::Perspective
+                   : CameraDesc::Type::Orthographic;
+    c.from = o.required("from").vec3();
+    const JsonValue to = o.required("to");
+    c.to = to.vec3();
+    const auto up = o.optional("up");
+    if (up) c.up = up->direction();
+    if (auto f = o.optional("fov")) c.fov = f->number(strictly_between(0, 180));
+    if (auto w = o.optional("width")) c.width = w->number(above(0));
+    o.finish();
+    const Vec3 view = c.to - c.from;
+    if (dot(view, view) == 0) to.fail(R"(must differ from "from")");
+    // Parallel within about 1e-6 radians would give a camera frame made of round-off.
+    if (length(cross(normalize(view), normalize(c.up))) < 1e-6) {
+      const std::string problem = "must not be parallel to the view direction";
+      if (up) up->fail(problem);
+      o.fail(fmt::format("up: {} (the default up is [0, 1, 0]; give another)", problem));
+    }
+    return c;
+  }
+
+  static IntegratorDesc read_integrator(const JsonValue& v) {
+    JsonObject o(v);
+    IntegratorDesc d;
+    if (auto x = o.optional("spp")) d.spp = x->integer(at_least(1));
+    if (auto x = o.optional("seed")) d.seed = x->unsigned_integer();
+    if (auto x = o.optional("max_depth")) d.max_depth = x->integer(at_least(1));
+    if (auto x = o.optional("tracking"))
+      d.tracking = string_choice(*x, "tracking",
+                                 {"delta", "spectral-max", "spectral-history", "spectral-mis"});
+    if (auto x = o.optional("absorption"))
+      d.absorption = string_choice(*x, "absorption", {"weight", "collide"});
+    if (auto x = o.optional("decomposition")) d.decomposition = x->boolean();
+    if (auto x = o.optional("transmittance"))
+      d.transmittance = string_choice(*x, "transmittance", {"ratio", "residual-ratio"});
+    if (auto x = o.optional("majorant")) {
+      JsonObject m(*x);
+      if (auto y = m.optional("source"))
+        d.majorant.source = string_choice(*y, "majorant source", {"bound", "sample"});
+      if (auto y = m.optional("samples")) d.majorant.samples = y->integer(at_least(1));
+      if (auto y = m.optional("scale")) d.majorant.scale = y->number(above(0));
+      m.finish();
+    }
+    if (auto x = o.optional("octree")) {
+      JsonObject t(*x);
+      if (auto y = t.optional("depth")) d.octree.depth = y->integer(between(0, 10));
+      t.finish();
+    }
+    o.finish();
+    return d;
+  }
+
+  static LightDesc read_light(const JsonValue& v) {
+    JsonObject o(v);
+    LightDesc l;
+    const JsonValue type = o.required("type");
+    const size_t kind =
+        type.choice("light type", {"environment", "directional", "point", "sphere"});
+    l.type = static_cast<LightDesc::Type>(kind);
+    switch (l.type) {
+      case LightDesc::Type::Environment:
+        l.radiance = o.required("radiance").rgb(at_least(0));
+        break;
+      case LightDesc::Type::Directional:
+        l.direction = normalize(o.required("direction").direction());
+        l.irradiance = o.required("irradiance").rgb(at_least(0));
+        break;
+      case LightDesc::Type::Point:
+        l.position = o.required("position").vec3();
+        l.intensity = o.required("intensity").rgb(at_least(0));
+        break;
+      case LightDesc::Type::Sphere:
+        l.center = o.required("center").vec3();
+        l.radius = o.required("radius").number(above(0));
+        l.radiance = o.required("radiance").rgb(at_least(0));
+        break;
+    }
+    o.finish(fmt::format("for a {} light", type.string()));
+    return l;
+  }
+
+  static MediumDesc read_medium(const std::string& name, const JsonValue& v) {
+    JsonObject o(v);
+    MediumDesc m;
+    m.name = name;
+    if (auto x = o.optional("sigma_a")) m.sigma_a = x->rgb(at_least(0));
+    if (auto x = o.optional("sigma_s")) m.sigma_s = x->rgb(at_least(0));
+    if (auto x = o.optional("emission")) m.emission = x->rgb(at_least(0));
+    if (auto x = o.optional("phase")) {
+      JsonObject p(*x);
+      std::string type = "isotropic";
+      if (auto t = p.optional("type")) {
+        type = string_choice(*t, "phase type", {"isotropic", "hg"});
+        if (type == "hg") m.phase.type = PhaseDesc::Type::HenyeyGreenstein;
+      }
+      if (type == "hg")
+        if (auto g = p.optional("g")) m.phase.g = g->number(strictly_between(-1, 1));
+      p.finish(fmt::format("for an {} phase function", type));
+    }
+    if (auto x = o.optional("density")) {
+      JsonObject d(*x);
+      std::string type = "constant";
+      if (auto t = d.optional("type")) {
+        type = string_choice(*t, "density type", {"constant", "field", "cloud"});
+        m.density.type = type == "constant" ? DensityDesc::Type::Constant
+                         : type == "field"  ? DensityDesc::Type::Field
+                                            : DensityDesc::Type::Cloud;
+      }
+      if (auto s = d.optional("scale")) m.density.scale = s->number(at_least(0));
+      if (m.density.type == DensityDesc::Type::Cloud) {
+        if (auto y = d.optional("octaves")) m.density.octaves = y->integer(between(1, 16));
+        if (auto y = d.optional("frequency")) m.density.frequency = y->number(above(0));
+        if (auto y = d.optional("amplitude"))
+          m.density.amplitude = y->number(Range{0.0, 1.0, true, false});
+        if (auto y = d.optional("seed")) m.density.seed = y->unsigned_integer();
+      }
+      d.finish(fmt::format("for a {} density", type));
+    }
+    o.finish();
+    return m;
+  }
+
+  ObjectDesc read_object(const JsonValue& v) {
+    JsonObject o(v);
+    ObjectDesc obj;
+    obj.json_path = v.pointer();
+    const JsonValue shape_value = o.required("shape");
+    obj.shape = shape(shape_value);
+    obj.shape_name = shape_value.json().is_string() ? shape_value.string() : "inline";
+    const auto medium = o.optional("medium");
+    if (medium) {
+      const auto it = media_index_.find(medium->string());
+      if (it == media_index_.end())
+        medium->fail(fmt::format("unknown medium \"{}\"", medium->string()));
+      obj.medium = it->second;
+    }
+    // Without a surface, an object with a medium is an index-matched volume, any other one a
+    // grey diffuse solid.
+    obj.surface.type = medium ? SurfaceDesc::Type::None : SurfaceDesc::Type::Diffuse;
+    std::optional<JsonValue> surface_type;
+    if (auto s = o.optional("surface")) {
+      JsonObject so(*s);
+      if ((surface_type = so.optional("type")))
+        obj.surface.type =
+            static_cast<SurfaceDesc::Type>(surface_type->choice("surface type", kSurfaceTypes));
+      switch (obj.surface.type) {
+        case SurfaceDesc::Type::None:
+          break;
+        case SurfaceDesc::Type::Diffuse:
+          if (auto a = so.optional("albedo")) obj.surface.albedo = a->rgb(between(0, 1));
+          break;
+        case SurfaceDesc::Type::Dielectric:
+          if (auto i = so.optional("ior")) obj.surface.ior = i->number(at_least(1));
+          break;
+        case SurfaceDesc::Type::Emissive:
+          obj.surface.radiance = so.required("radiance").rgb(at_least(0));
+          break;
+      }
+      so.finish(fmt::format("for a {} surface", kSurfaceTypes[static_cast<int>(obj.surface.type)]));
+    }
+    o.finish();
+    if (obj.surface.type == SurfaceDesc::Type::None && !medium)
+      surface_type->fail(R"(surface "none" needs a medium: the object would be invisible)");
+    // A medium behind an opaque surface could never be reached by any ray.
+    if (medium && obj.surface.type != SurfaceDesc::Type::None &&
+        obj.surface.type != SurfaceDesc::Type::Dielectric)
+      medium->fail(R"(only objects with surface "none" or "dielectric" can hold a medium)");
+    return obj;
+  }
+
+  // A shape where one is expected: the name of a shape in "shapes", or an inline shape object.
+  ShapePtr shape(const JsonValue& v) {
+    if (v.json().is_object()) return inline_shape(v);
+    if (!v.json().is_string()) v.fail("expected a shape name or an inline shape object");
+    const std::string name = v.string();
+    if (!shapes_ || !shapes_->has(name)) v.fail(fmt::format("unknown shape \"{}\"", name));
+    return named_shape(name, v);
+  }
+
+  // Builds a named shape once; `via` is the value that refers to it (or its own definition).
+  ShapePtr named_shape(const std::string& name, const JsonValue& via) {
+    if (const auto it = built_.find(name); it != built_.end()) return it->second;
+    for (size_t i = 0; i < resolving_.size(); ++i) {
+      if (resolving_[i].name != name) continue;
+      std::string chain;
+      for (size_t k = i; k < resolving_.size(); ++k) chain += resolving_[k].name + " -> ";
+      // Reported at the reference that leaves the first shape of the cycle.
+      const JsonValue& at = i + 1 < resolving_.size() ? resolving_[i + 1].via : via;
+      at.fail("cycle in shape references: " + chain + name);
+    }
+    resolving_.push_back({name, via});
+    ShapePtr s = inline_shape(*shapes_->optional(name));
+    resolving_.pop_back();
+    built_[name] = s;
+    return s;
+  }
+
+  ShapePtr inline_shape(const JsonValue& v) {
+    JsonObject o(v);
+    const JsonValue type = o.required("type");
+    const std::string kind = string_choice(
+        type, "shape type",
+        {"quadric", "sphere", "ellipsoid", "cylinder", "cone", "paraboloid", "halfspace", "slab",
+         "box", "freeform", "union", "intersection", "difference"});
+    const auto point = [&](const char* key) {
+      const auto p = o.optional(key);
+      return p ? p->vec3() : Vec3{};
+    };
+    ShapePtr s;
+    if (kind == "quadric") {
+      const JsonValue c = o.required("coefficients");
+      if (!c.json().is_array() || c.json().size() != 10) c.fail("expected an array of 10 numbers");
+      Quadric q;
+      bool all_zero = true;
+      for (size_t i = 0; i < 10; ++i) {
+        q.a[i] = c.array()[i].number();
+        all_zero = all_zero && q.a[i] == 0;
+      }
+      if (all_zero) c.fail("must not all be zero");
+      s = make_shape(QuadricNode{q});
+    } else if (kind == "sphere") {
+      const Vec3 center = point("center");
+      s = make_shape(QuadricNode{sphere(center, o.required("radius").number(above(0)))});
+    } else if (kind == "ellipsoid") {
+      const Vec3 center = point("center");
+      s = make_shape(QuadricNode{ellipsoid(center, o.required("radii").vec3(above(0)))});
+    } else if (kind == "cylinder") {
+      const Vec3 p = point("point");
+      const Vec3 axis = o.required("axis").direction();
+      s = make_shape(QuadricNode{cylinder(p, axis, o.required("radius").number(above(0)))});
+    } else if (kind == "cone") {
+      const Vec3 apex = point("apex");
+      const Vec3 axis = o.required("axis").direction();
+      const double angle = o.required("half_angle").number(strictly_between(0, 90));
+      s = make_shape(QuadricNode{cone(apex, axis, angle)});
+    } else if (kind == "paraboloid") {
+      const Vec3 vertex = point("vertex");
+      const Vec3 axis = o.required("axis").direction();
+      const double f = o.required("focal_length").number(above(0));
+      s = make_shape(QuadricNode{paraboloid(vertex, axis, f)});
+    } else if (kind == "halfspace") {
+      const Vec3 p = point("point");
+      s = make_shape(QuadricNode{halfspace(p, o.required("normal").direction())});
+    } else if (kind == "slab") {
+      const Vec3 center = point("center");
+      const Vec3 normal = o.required("normal").direction();
+      s = make_shape(QuadricNode{slab(center, normal, o.required("thickness").number(above(0)))});
+    } else if (kind == "box") {
+      const Vec3 lo = o.required("min").vec3();
+      const JsonValue max_value = o.required("max");
+      const Vec3 hi = max_value.vec3();
+      for (int i = 0; i < 3; ++i)
+        if (!(hi[i] > lo[i]))
+          max_value.array()[i].fail(fmt::format("must be greater than min ({})", lo[i]));
+      s = box(lo, hi);
+    } else if (kind == "freeform") {
+      FreeFormNode node;
+      node.base = shape(o.required("base"));
+      if (auto ps = o.optional("perturbations")) {
+        for (const JsonValue& pv : ps->array()) {
+          JsonObject p(pv);
+          Perturbation pert;
+          pert.shape = shape(p.required("shape"));
+          pert.weight = p.required("weight").number();
+          p.finish();
+          node.perturbations.push_back(pert);
+        }
+      }
+      s = make_shape(std::move(node));
+    } else {
+      CsgNode node;
+      node.op = kind == "union"          ? CsgOp::Union
+                : kind == "intersection" ? CsgOp::Intersection
+                                         : CsgOp::Difference;
+      const JsonValue children = o.required("shapes");
+      const size_t min_children = node.op == CsgOp::Difference ? 2 : 1;
+      const std::vector<JsonValue> list = children.array();
+      if (list.size() < min_children)
+        children.fail(
+            fmt::format("expected at least {} shape{}", min_children, min_children > 1 ? "s" : ""));
+      for (const JsonValue& c : list) node.children.push_back(shape(c));
+      s = make_shape(std::move(node));
+    }
+    const auto transform = o.optional("transform");
+    o.finish(fmt::format("for a {}", kind));
+    return transform ? with_transform(s, read_transform(*transform)) : s;
+  }
+
+  struct Visit {
+    std::string name;
+    JsonValue via;
+  };
+
+  JsonObject root_;
+  std::optional<JsonObject> shapes_;
+  std::map<std::string, ShapePtr> built_;
+  std::vector<Visit> resolving_;  // named shapes being built, outermost first
+  std::map<std::string, int> media_index_;
+};
+
+std::string read_file(const std::string& path) {
+  if (std::filesystem::is_directory(path))
+    throw SceneError(path + ": cannot open file (is a directory)");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(fmt::format("{}: cannot open file ({})", path, std::strerror(errno)));
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad())
+    throw SceneError(fmt::format("{}: cannot read file ({})", path, std::strerror(errno)));
+  return text.str();
+}
+
+}  // namespace
+
+std::string apply_override(nlohmann::json& j, const std::string& key_equals_value) {
+  const auto fail = [&](const std::string& problem) {
+    throw SceneError(fmt::format("--set {}: {}", key_equals_value, problem));
+  };
+  const size_t eq = key_equals_value.find('=');
+  if (eq == std::string::npos) fail("expected KEY=VALUE");
+  const std::string key = key_equals_value.substr(0, eq);
+  const std::string text = key_equals_value.substr(eq + 1);
+
+  std::vector<std::string> parts;
+  for (size_t start = 0;;) {
+    const size_t dot = key.find('.', start);
+    parts.push_back(key.substr(start, dot - start));
+    if (parts.back().empty()) fail("empty name in key \"" + key + "\"");
+    if (dot == std::string::npos) break;
+    start = dot + 1;
+  }
+
+  nlohmann::json* cur = &j;
+  std::string pointer, dotted;
+  for (const std::string& part : parts) {
+    if (cur->is_array()) {
+      const bool digits =
+          part.find_first_not_of("0123456789") == std::string::npos && part.size() < 10;
+      if (!digits) fail(fmt::format("{} is an array; \"{}\" is not an index", dotted, part));
+      const size_t index = std::stoul(part);
+      if (index >= cur->size())
+        fail(fmt::format("index {} is out of range for {} (size {})", index, dotted, cur->size()));
+      cur = &(*cur)[index];
+    } else if (cur->is_object()) {
+      cur = &(*cur)[part];  // creates the key (as null) if missing
+    } else if (cur->is_null()) {
+      *cur = nlohmann::json::object();  // a key created on the way
+      cur = &(*cur)[part];
+    } else {
+      fail(fmt::format("{} is not an object", dotted));
+    }
+    pointer = child_pointer(pointer, part);
+    dotted += (dotted.empty() ? "" : ".") + part;
+  }
+
+  nlohmann::json value;
+  try {
+    value = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception&) {
+    value = text;  // a bare word such as perspective
+  }
+  *cur = std::move(value);
+  return pointer;
+}
+
+SceneDesc load_scene_json(nlohmann::json j, const std::string& source,
+                          const std::vector<std::string>& overrides) {
+  JsonOrigin origin{source, {}};
+  for (const std::string& o : overrides)
+    origin.overrides.push_back({apply_override(j, o), "--set " + o});
+  return Loader(JsonValue(j, "", origin)).load();
+}
+
+SceneDesc load_scene_file(const std::string& path, const std::vector<std::string>& overrides) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(read_file(path), nullptr, true, /*ignore_comments=*/true);
+  } catch (const nlohmann::json::exception& e) {
+    // what() is "[json.exception.parse_error.101] parse error at line 3, column 5: ..." (or an
+    // out_of_range error for numbers beyond double).
+    std::string what = e.what();
+    const size_t bracket = what.find("] ");
+    throw SceneError(path + ": " +
+                     (bracket == std::string::npos ? what : what.substr(bracket + 2)));
+  }
+  return load_scene_json(std::move(j), path, overrides);
+}
+
+}  // namespace nimbus

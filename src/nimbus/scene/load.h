@@ -1,0 +1,29 @@
+#pragma once
+// Loading a scene file (docs/scene-format.md) into a SceneDesc. All validation happens here:
+// every error is a SceneError whose message is one line, "SOURCE: /json/pointer: problem", where
+// SOURCE is the file name, or the "--set KEY=VALUE" flag that put the offending value in place.
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "nimbus/scene/json_reader.h"
+#include "nimbus/scene/scene_desc.h"
+
+namespace nimbus {
+
+// Reads, parses (comments allowed), applies the overrides in order and validates.
+SceneDesc load_scene_file(const std::string& path, const std::vector<std::string>& overrides = {});
+
+// As load_scene_file for a document already in memory; `source` names it in messages.
+SceneDesc load_scene_json(nlohmann::json j, const std::string& source,
+                          const std::vector<std::string>& overrides = {});
+
+// Applies one `--set KEY=VALUE`: KEY is a dotted path into the document (array elements by
+// index, as in lights.0.radiance), VALUE is parsed as JSON or else taken as a string. Missing
+// object keys along the path are created; a path through a value that is neither an object nor
+// an array, or past the end of an array, is an error "--set KEY=VALUE: problem". Returns the
+// JSON pointer of the value it set.
+std::string apply_override(nlohmann::json& j, const std::string& key_equals_value);
+
+}  // namespace nimbus

@@ -1,0 +1,108 @@
+#pragma once
+// The scene as the scene file states it, validated (scene/load.h) and nothing more: plain
+// structs with the file's defaults. Compilation into run-time structures happens elsewhere and
+// trusts these values; docs/scene-format.md documents every field.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "nimbus/frep/shape_desc.h"
+#include "nimbus/math/vec3.h"
+#include "nimbus/spectral/spectrum.h"
+
+namespace nimbus {
+
+struct FilmDesc {
+  int width = 640, height = 480;
+};
+
+struct CameraDesc {
+  enum class Type { Perspective, Orthographic };
+  Type type = Type::Perspective;
+  Vec3 from, to, up{0, 1, 0};
+  double fov = 40;   // vertical field of view in degrees (perspective)
+  double width = 2;  // width of the view in world units (orthographic)
+};
+
+struct IntegratorDesc {
+  int spp = 16;
+  uint64_t seed = 0;
+  int max_depth = 1000;
+  std::string tracking = "delta";     // delta | spectral-max | spectral-history | spectral-mis
+  std::string absorption = "weight";  // weight | collide
+  bool decomposition = false;
+  std::string transmittance = "ratio";  // ratio | residual-ratio
+  struct Majorant {
+    std::string source = "bound";  // bound | sample
+    int samples = 4096;            // points per octree node for source "sample"
+    double scale = 1.0;            // safety factor applied to every majorant
+  } majorant;
+  struct Octree {
+    int depth = 0;  // 0: one global majorant
+  } octree;
+};
+
+struct LightDesc {
+  enum class Type { Environment, Directional, Point, Sphere };
+  Type type = Type::Environment;
+  Rgb radiance;    // environment, sphere
+  Rgb irradiance;  // directional
+  Rgb intensity;   // point
+  Vec3 direction;  // directional: the direction the light travels, unit length
+  Vec3 position;   // point
+  Vec3 center;     // sphere
+  double radius = 0;
+};
+
+struct PhaseDesc {
+  enum class Type { Isotropic, HenyeyGreenstein };
+  Type type = Type::Isotropic;
+  double g = 0;
+};
+
+struct DensityDesc {
+  enum class Type { Constant, Field, Cloud };
+  Type type = Type::Constant;
+  double scale = 1;
+  // Cloud noise: fractal sum of `octaves` noise octaves starting at `frequency`, each octave's
+  // amplitude `amplitude` times the previous one's.
+  int octaves = 5;
+  double frequency = 2, amplitude = 0.6;
+  uint64_t seed = 0;
+};
+
+struct MediumDesc {
+  std::string name;
+  Rgb sigma_a, sigma_s, emission;
+  PhaseDesc phase;
+  DensityDesc density;
+};
+
+struct SurfaceDesc {
+  enum class Type { None, Diffuse, Dielectric, Emissive };
+  Type type = Type::Diffuse;
+  Rgb albedo{0.5};   // diffuse
+  double ior = 1.5;  // dielectric
+  Rgb radiance;      // emissive
+};
+
+struct ObjectDesc {
+  ShapePtr shape;
+  std::string shape_name;  // the name in "shapes", or "inline"
+  std::string json_path;   // e.g. "/objects/1", for messages from later stages
+  SurfaceDesc surface;
+  int medium = -1;  // index into SceneDesc::media, or -1
+};
+
+struct SceneDesc {
+  std::string source;  // the file name (or other source) used in messages
+  FilmDesc film;
+  CameraDesc camera;
+  IntegratorDesc integrator;
+  std::vector<LightDesc> lights;
+  std::vector<MediumDesc> media;
+  std::vector<ObjectDesc> objects;
+};
+
+}  // namespace nimbus

@@ -1,0 +1,586 @@
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "nimbus/frep/primitives.h"
+#include "nimbus/scene/load.h"
+
+namespace nimbus {
+namespace {
+
+// The example of docs/scene-format.md.
+constexpr const char* kExample = R"({
+  "film":    {"width": 640, "height": 480},
+  "camera":  {"type": "perspective", "from": [0,1,6], "to": [0,0,0], "up": [0,1,0], "fov": 35},
+  "integrator": {"spp": 64, "seed": 0, "max_depth": 1000},
+  "lights": [
+    {"type": "environment", "radiance": [0.8,0.9,1.0]},
+    {"type": "directional", "direction": [0,-1,0], "irradiance": [3,3,3]},
+    {"type": "point", "position": [1,4,2], "intensity": [10,10,10]},
+    {"type": "sphere", "center": [0,5,0], "radius": 0.5, "radiance": [20,20,20]}
+  ],
+  "shapes": {
+    "ball":  {"type": "sphere", "center": [0,0,0], "radius": 1},
+    "bump":  {"type": "quadric", "coefficients": [-4,-4,-4,0,0,0,0,0,4,-0.75]},
+    "blob":  {"type": "freeform", "base": "ball", "perturbations": [{"shape": "bump", "weight": 2.5}],
+              "transform": [{"rotate": {"axis": [0,1,0], "degrees": 30}}, {"translate": [0,0.2,0]}]},
+    "floor": {"type": "box", "min": [-5,-1.2,-5], "max": [5,-1,5]}
+  },
+  "media": {
+    "marble": {"sigma_a": [0.0021,0.0041,0.0071], "sigma_s": [2.19,2.62,3.00], "phase": {"type": "hg", "g": 0.0}, "density": {"type": "constant"}},
+    "haze":   {"sigma_a": 0.05, "sigma_s": [0.9,1.0,1.2], "density": {"type": "field", "scale": 2.0}},
+    "cloud":  {"sigma_a": 0.0, "sigma_s": [8,9,10], "phase": {"type": "hg", "g": 0.85}, "density": {"type": "cloud", "octaves": 5, "frequency": 2.0, "amplitude": 0.6, "seed": 7}},
+    "fire":   {"sigma_a": 2, "sigma_s": 0.5, "emission": [4,1.5,0.2]}
+  },
+  "objects": [
+    {"shape": "blob",  "surface": {"type": "diffuse", "albedo": [0.7,0.5,0.3]}},
+    {"shape": "floor", "surface": {"type": "diffuse", "albedo": 0.5}},
+    {"shape": "blob",  "medium": "marble", "surface": {"type": "dielectric", "ior": 1.5}},
+    {"shape": "ball",  "medium": "cloud",  "surface": {"type": "none"}}
+  ]
+})";
+
+SceneDesc load(const std::string& text, const std::vector<std::string>& overrides = {}) {
+  return load_scene_json(nlohmann::json::parse(text), "scene.json", overrides);
+}
+
+std::string load_error(const std::string& text, const std::vector<std::string>& overrides = {}) {
+  try {
+    load(text, overrides);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+// A document with a valid camera and the given further top-level members.
+std::string with_camera(const std::string& members) {
+  return R"({"camera": {"from": [0, 0, 5], "to": [0, 0, 0]})" +
+         (members.empty() ? "" : ", " + members) + "}";
+}
+
+std::string with_shape(const std::string& shape) {
+  return with_camera(R"("shapes": {"ball": )" + shape + "}");
+}
+
+std::string with_medium(const std::string& medium) {
+  return with_camera(R"("media": {"cloud": )" + medium + "}");
+}
+
+std::string with_object(const std::string& object) {
+  return with_camera(R"("media": {"smoke": {"sigma_s": 1}}, "objects": [)" + object + "]");
+}
+
+struct BadScene {
+  const char* what;
+  std::string text;
+  std::vector<std::string> overrides;
+  std::string message;
+};
+
+std::vector<BadScene> bad_scenes() {
+  const std::string ball = R"({"type": "sphere", "radius": 1})";
+  return {
+      {"root is not an object", "[1, 2]", {}, "scene.json: /: expected an object, not an array"},
+      {"missing camera", "{}", {}, "scene.json: /camera: required key is missing"},
+      {"misspelt section",
+       with_camera(R"("objcts": [])"),
+       {},
+       R"(scene.json: /objcts: unknown key (did you mean "objects"?))"},
+      {"unknown camera key",
+       R"({"camera": {"from": [0, 0, 5], "to": [0, 0, 0], "fvo": 30}})",
+       {},
+       R"(scene.json: /camera/fvo: unknown key (did you mean "fov"?))"},
+      {"misspelt required key",
+       R"({"camera": {"form": [0, 0, 5], "to": [0, 0, 0]}})",
+       {},
+       R"(scene.json: /camera/form: unknown key (did you mean "from"?))"},
+      {"wrong type",
+       with_camera(R"("film": {"width": "640"})"),
+       {},
+       "scene.json: /film/width: expected an integer, not a string"},
+      {"fraction for integer",
+       with_camera(R"("film": {"height": 480.5})"),
+       {},
+       "scene.json: /film/height: expected an integer, not a fraction"},
+      {"film width 0",
+       with_camera(R"("film": {"width": 0})"),
+       {},
+       "scene.json: /film/width: must be in [1, 16384]"},
+      {"vector too short",
+       R"({"camera": {"from": [0, 5], "to": [0, 0, 0]}})",
+       {},
+       "scene.json: /camera/from: expected an array of 3 numbers"},
+      {"camera from == to",
+       R"({"camera": {"from": [1, 2, 3], "to": [1, 2, 3]}})",
+       {},
+       R"(scene.json: /camera/to: must differ from "from")"},
+      {"up parallel to view",
+       R"({"camera": {"from": [0, 5, 0], "to": [0, 0, 0], "up": [0, 2, 0]}})",
+       {},
+       "scene.json: /camera/up: must not be parallel to the view direction"},
+      {"fov out of range",
+       R"({"camera": {"from": [0, 0, 5], "to": [0, 0, 0], "fov": 180}})",
+       {},
+       "scene.json: /camera/fov: must be in (0, 180)"},
+      {"unknown camera type",
+       R"({"camera": {"type": "fisheye", "from": [0, 0, 5], "to": [0, 0, 0]}})",
+       {},
+       R"(scene.json: /camera/type: unknown camera type "fisheye" (expected one of: perspective, orthographic))"},
+      {"spp 0",
+       with_camera(R"("integrator": {"spp": 0})"),
+       {},
+       "scene.json: /integrator/spp: must be >= 1"},
+      {"negative seed",
+       with_camera(R"("integrator": {"seed": -1})"),
+       {},
+       "scene.json: /integrator/seed: must be >= 0"},
+      {"unknown tracking",
+       with_camera(R"("integrator": {"tracking": "ratio"})"),
+       {},
+       R"(scene.json: /integrator/tracking: unknown tracking "ratio" (expected one of: delta, spectral-max, spectral-history, spectral-mis))"},
+      {"decomposition not boolean",
+       with_camera(R"("integrator": {"decomposition": "yes"})"),
+       {},
+       "scene.json: /integrator/decomposition: expected true or false, not a string"},
+      {"octree too deep",
+       with_camera(R"("integrator": {"octree": {"depth": 11}})"),
+       {},
+       "scene.json: /integrator/octree/depth: must be in [0, 10]"},
+      {"zero light direction",
+       with_camera(
+           R"("lights": [{"type": "directional", "direction": [0, 0, 0], "irradiance": 1}])"),
+       {},
+       "scene.json: /lights/0/direction: must be a nonzero vector"},
+      {"key of another light type",
+       with_camera(
+           R"("lights": [{"type": "point", "position": [0, 0, 0], "intensity": 1, "radius": 1}])"),
+       {},
+       "scene.json: /lights/0/radius: unknown key for a point light"},
+      {"negative radiance",
+       with_camera(R"("lights": [{"type": "environment", "radiance": [1, 1, -0.5]}])"),
+       {},
+       "scene.json: /lights/0/radiance/2: must be >= 0"},
+      {"negative radius",
+       with_shape(R"({"type": "sphere", "radius": -1})"),
+       {},
+       "scene.json: /shapes/ball/radius: must be > 0"},
+      {"zero ellipsoid radius",
+       with_shape(R"({"type": "ellipsoid", "radii": [1, 2, 0]})"),
+       {},
+       "scene.json: /shapes/ball/radii/2: must be > 0"},
+      {"unknown primitive type",
+       with_shape(R"({"type": "sphre", "radius": 1})"),
+       {},
+       R"(scene.json: /shapes/ball/type: unknown shape type "sphre" (expected one of: quadric, sphere, ellipsoid, cylinder, cone, paraboloid, halfspace, slab, box, freeform, union, intersection, difference))"},
+      {"cone angle",
+       with_shape(R"({"type": "cone", "axis": [0, 1, 0], "half_angle": 90})"),
+       {},
+       "scene.json: /shapes/ball/half_angle: must be in (0, 90)"},
+      {"quadric coefficient count",
+       with_shape(R"({"type": "quadric", "coefficients": [1, 2, 3]})"),
+       {},
+       "scene.json: /shapes/ball/coefficients: expected an array of 10 numbers"},
+      {"empty box",
+       with_shape(R"({"type": "box", "min": [0, 0, 0], "max": [1, 0, 1]})"),
+       {},
+       "scene.json: /shapes/ball/max/1: must be greater than min (0)"},
+      {"difference of one",
+       with_shape(R"({"type": "difference", "shapes": [)" + ball + "]}"),
+       {},
+       "scene.json: /shapes/ball/shapes: expected at least 2 shapes"},
+      {"perturbation without weight",
+       with_shape(R"({"type": "freeform", "base": )" + ball + R"(, "perturbations": [{"shape": )" +
+                  ball + "}]}"),
+       {},
+       "scene.json: /shapes/ball/perturbations/0/weight: required key is missing"},
+      {"key of another shape type",
+       with_shape(R"({"type": "sphere", "radius": 1, "axis": [0, 1, 0]})"),
+       {},
+       "scene.json: /shapes/ball/axis: unknown key for a sphere"},
+      {"unknown shape name",
+       with_camera(R"("shapes": {"blob": )" + ball +
+                   R"(}, "objects": [{"shape": "blob"}, {"shape": "blobb"}])"),
+       {},
+       R"(scene.json: /objects/1/shape: unknown shape "blobb")"},
+      {"shape of wrong type",
+       with_camera(R"("objects": [{"shape": 3}])"),
+       {},
+       "scene.json: /objects/0/shape: expected a shape name or an inline shape object"},
+      {"reference cycle",
+       with_camera(R"("shapes": {"a": {"type": "freeform", "base": "b"},
+                                 "b": {"type": "union", "shapes": ["a"]}})"),
+       {},
+       "scene.json: /shapes/a/base: cycle in shape references: a -> b -> a"},
+      {"cycle behind a reference",
+       with_camera(R"("shapes": {"a": {"type": "union", "shapes": ["b"]},
+                                 "b": {"type": "union", "shapes": ["c"]},
+                                 "c": {"type": "intersection", "shapes": [)" +
+                   ball + R"(, "b"]}})"),
+       {},
+       "scene.json: /shapes/b/shapes/0: cycle in shape references: b -> c -> b"},
+      {"self reference",
+       with_camera(R"("shapes": {"u": {"type": "union", "shapes": ["u"]}})"),
+       {},
+       "scene.json: /shapes/u/shapes/0: cycle in shape references: u -> u"},
+      {"zero scale",
+       with_shape(R"({"type": "sphere", "radius": 1, "transform": [{"scale": 0}]})"),
+       {},
+       "scene.json: /shapes/ball/transform/0/scale: must be nonzero"},
+      {"zero scale component",
+       with_shape(R"({"type": "sphere", "radius": 1, "transform": [{"scale": [1, 0, 1]}]})"),
+       {},
+       "scene.json: /shapes/ball/transform/0/scale/1: must be nonzero"},
+      {"degenerate transform",
+       with_shape(R"({"type": "sphere", "radius": 1, "transform": [{"scale": [0.5, 1e-12, 1]}]})"),
+       {},
+       "scene.json: /shapes/ball/transform: degenerate transform (determinant 5e-13)"},
+      {"zero rotation axis",
+       with_shape(
+           R"({"type": "sphere", "radius": 1, "transform": [{"rotate": {"axis": [0, 0, 0], "degrees": 5}}]})"),
+       {},
+       "scene.json: /shapes/ball/transform/0/rotate/axis: must be a nonzero vector"},
+      {"two steps in one",
+       with_shape(
+           R"({"type": "sphere", "radius": 1, "transform": [{"scale": 2, "translate": [1, 0, 0]}]})"),
+       {},
+       R"(scene.json: /shapes/ball/transform/0: expected exactly one of "translate", "rotate", "scale")"},
+      {"negative sigma",
+       with_medium(R"({"sigma_s": [1, -2, 3]})"),
+       {},
+       "scene.json: /media/cloud/sigma_s/1: must be >= 0"},
+      {"g out of range",
+       with_medium(R"({"phase": {"type": "hg", "g": 1}})"),
+       {},
+       "scene.json: /media/cloud/phase/g: must be in (-1, 1)"},
+      {"g of isotropic phase",
+       with_medium(R"({"phase": {"g": 0.5}})"),
+       {},
+       "scene.json: /media/cloud/phase/g: unknown key for an isotropic phase function"},
+      {"unknown density type",
+       with_medium(R"({"density": {"type": "vdb"}})"),
+       {},
+       R"(scene.json: /media/cloud/density/type: unknown density type "vdb" (expected one of: constant, field, cloud))"},
+      {"cloud key on constant density",
+       with_medium(R"({"density": {"octaves": 3}})"),
+       {},
+       "scene.json: /media/cloud/density/octaves: unknown key for a constant density"},
+      {"ior below 1",
+       with_object(R"({"shape": )" + ball + R"(, "surface": {"type": "dielectric", "ior": 0.9}})"),
+       {},
+       "scene.json: /objects/0/surface/ior: must be >= 1"},
+      {"albedo above 1",
+       with_object(R"({"shape": )" + ball + R"(, "surface": {"albedo": [0.5, 1.5, 0.5]}})"),
+       {},
+       "scene.json: /objects/0/surface/albedo/1: must be in [0, 1]"},
+      {"unknown medium",
+       with_object(R"({"shape": )" + ball + R"(, "medium": "smok"})"),
+       {},
+       R"(scene.json: /objects/0/medium: unknown medium "smok")"},
+      {"invisible object",
+       with_object(R"({"shape": )" + ball + R"(, "surface": {"type": "none"}})"),
+       {},
+       R"(scene.json: /objects/0/surface/type: surface "none" needs a medium: the object would be invisible)"},
+      {"medium behind opaque surface",
+       with_object(R"({"shape": )" + ball +
+                   R"(, "medium": "smoke", "surface": {"type": "diffuse"}})"),
+       {},
+       R"(scene.json: /objects/0/medium: only objects with surface "none" or "dielectric" can hold a medium)"},
+      {"emissive without radiance",
+       with_object(R"({"shape": )" + ball + R"(, "surface": {"type": "emissive"}})"),
+       {},
+       "scene.json: /objects/0/surface/radiance: required key is missing"},
+      {"objects not an array",
+       with_camera(R"("objects": {})"),
+       {},
+       "scene.json: /objects: expected an array, not an object"},
+      {"--set value of wrong type",
+       with_camera(""),
+       {"integrator.spp=abc"},
+       "--set integrator.spp=abc: /integrator/spp: expected an integer, not a string"},
+      {"--set misspelt key",
+       with_camera(""),
+       {"camera.fvo=20"},
+       R"(--set camera.fvo=20: /camera/fvo: unknown key (did you mean "fov"?))"},
+      {"--set through a number",
+       with_camera(R"("film": {"width": 10})"),
+       {"film.width.x=3"},
+       "--set film.width.x=3: film.width is not an object"},
+      {"--set without =",
+       with_camera(""),
+       {"integrator.spp"},
+       "--set integrator.spp: expected KEY=VALUE"},
+      {"--set past an array's end",
+       with_camera(R"("lights": [])"),
+       {"lights.0.radiance=1"},
+       "--set lights.0.radiance=1: index 0 is out of range for lights (size 0)"},
+      {"--set non-index into array",
+       with_camera(R"("lights": [])"),
+       {"lights.x=1"},
+       R"(--set lights.x=1: lights is an array; "x" is not an index)"},
+      {"--set empty name",
+       with_camera(""),
+       {"film..width=3"},
+       R"(--set film..width=3: empty name in key "film..width")"},
+  };
+}
+
+TEST(SceneLoad, MalformedScenesGiveOneLineErrorsNamingThePath) {
+  const std::vector<BadScene> cases = bad_scenes();
+  EXPECT_GE(cases.size(), 25u);
+  for (const BadScene& c : cases) {
+    const std::string message = load_error(c.text, c.overrides);
+    EXPECT_EQ(message, c.message) << c.what;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << c.what;
+  }
+}
+
+TEST(SceneLoad, ExampleLoads) {
+  const SceneDesc s = load(kExample);
+  EXPECT_EQ(s.source, "scene.json");
+  EXPECT_EQ(s.film.width, 640);
+  EXPECT_EQ(s.film.height, 480);
+  EXPECT_EQ(s.camera.type, CameraDesc::Type::Perspective);
+  EXPECT_EQ(s.camera.from, (Vec3{0, 1, 6}));
+  EXPECT_EQ(s.camera.fov, 35);
+  EXPECT_EQ(s.integrator.spp, 64);
+  EXPECT_EQ(s.integrator.tracking, "delta");
+
+  ASSERT_EQ(s.lights.size(), 4u);
+  EXPECT_EQ(s.lights[0].type, LightDesc::Type::Environment);
+  EXPECT_EQ(s.lights[0].radiance, Rgb({0.8, 0.9, 1.0}));
+  EXPECT_EQ(s.lights[1].type, LightDesc::Type::Directional);
+  EXPECT_EQ(s.lights[1].direction, (Vec3{0, -1, 0}));
+  EXPECT_EQ(s.lights[1].irradiance, Rgb(3));
+  EXPECT_EQ(s.lights[2].type, LightDesc::Type::Point);
+  EXPECT_EQ(s.lights[2].position, (Vec3{1, 4, 2}));
+  EXPECT_EQ(s.lights[3].type, LightDesc::Type::Sphere);
+  EXPECT_EQ(s.lights[3].radius, 0.5);
+
+  // Media are ordered by name; objects refer to them by index.
+  ASSERT_EQ(s.media.size(), 4u);
+  EXPECT_EQ(s.media[0].name, "cloud");
+  EXPECT_EQ(s.media[0].phase.type, PhaseDesc::Type::HenyeyGreenstein);
+  EXPECT_EQ(s.media[0].phase.g, 0.85);
+  EXPECT_EQ(s.media[0].density.type, DensityDesc::Type::Cloud);
+  EXPECT_EQ(s.media[0].density.seed, 7u);
+  EXPECT_EQ(s.media[1].name, "fire");
+  EXPECT_EQ(s.media[1].emission, Rgb({4, 1.5, 0.2}));
+  EXPECT_EQ(s.media[1].phase.type, PhaseDesc::Type::Isotropic);
+  EXPECT_EQ(s.media[2].name, "haze");
+  EXPECT_EQ(s.media[2].sigma_a, Rgb(0.05));
+  EXPECT_EQ(s.media[2].density.type, DensityDesc::Type::Field);
+  EXPECT_EQ(s.media[2].density.scale, 2.0);
+  EXPECT_EQ(s.media[3].name, "marble");
+
+  ASSERT_EQ(s.objects.size(), 4u);
+  EXPECT_EQ(s.objects[0].shape_name, "blob");
+  EXPECT_EQ(s.objects[0].json_path, "/objects/0");
+  EXPECT_EQ(s.objects[0].surface.type, SurfaceDesc::Type::Diffuse);
+  EXPECT_EQ(s.objects[0].surface.albedo, Rgb({0.7, 0.5, 0.3}));
+  EXPECT_EQ(s.objects[0].medium, -1);
+  EXPECT_EQ(s.objects[1].surface.albedo, Rgb(0.5));
+  EXPECT_EQ(s.objects[2].medium, 3);
+  EXPECT_EQ(s.objects[2].surface.type, SurfaceDesc::Type::Dielectric);
+  EXPECT_EQ(s.objects[3].medium, 0);
+  EXPECT_EQ(s.objects[3].surface.type, SurfaceDesc::Type::None);
+
+  // The box is the intersection of three slabs.
+  const auto* floor = std::get_if<CsgNode>(&s.objects[1].shape->node);
+  ASSERT_NE(floor, nullptr);
+  EXPECT_EQ(floor->op, CsgOp::Intersection);
+  EXPECT_EQ(floor->children.size(), 3u);
+}
+
+TEST(SceneLoad, NamedShapesAreBuiltOnceAndShared) {
+  const SceneDesc s = load(kExample);
+  EXPECT_EQ(s.objects[0].shape, s.objects[2].shape);
+  const auto* blob = std::get_if<FreeFormNode>(&s.objects[0].shape->node);
+  ASSERT_NE(blob, nullptr);
+  EXPECT_EQ(blob->base, s.objects[3].shape);  // "ball"
+  ASSERT_EQ(blob->perturbations.size(), 1u);
+  EXPECT_EQ(blob->perturbations[0].weight, 2.5);
+  const auto* bump = std::get_if<QuadricNode>(&blob->perturbations[0].shape->node);
+  ASSERT_NE(bump, nullptr);
+  EXPECT_EQ(bump->q.a, (std::array<double, 10>{-4, -4, -4, 0, 0, 0, 0, 0, 4, -0.75}));
+}
+
+TEST(SceneLoad, DefaultsApplyWhereKeysAreOptional) {
+  const SceneDesc s = load(with_camera(R"(
+      "media": {"m": {}},
+      "objects": [{"shape": {"type": "sphere", "radius": 1}},
+                  {"shape": {"type": "sphere", "radius": 1}, "medium": "m"}])"));
+  EXPECT_EQ(s.film.width, 640);
+  EXPECT_EQ(s.film.height, 480);
+  EXPECT_EQ(s.camera.type, CameraDesc::Type::Perspective);
+  EXPECT_EQ(s.camera.up, (Vec3{0, 1, 0}));
+  EXPECT_EQ(s.camera.fov, 40);
+  EXPECT_EQ(s.integrator.spp, 16);
+  EXPECT_EQ(s.integrator.seed, 0u);
+  EXPECT_EQ(s.integrator.max_depth, 1000);
+  EXPECT_EQ(s.integrator.absorption, "weight");
+  EXPECT_FALSE(s.integrator.decomposition);
+  EXPECT_EQ(s.integrator.transmittance, "ratio");
+  EXPECT_EQ(s.integrator.majorant.source, "bound");
+  EXPECT_EQ(s.integrator.majorant.samples, 4096);
+  EXPECT_EQ(s.integrator.majorant.scale, 1.0);
+  EXPECT_EQ(s.integrator.octree.depth, 0);
+  EXPECT_TRUE(s.lights.empty());
+  ASSERT_EQ(s.media.size(), 1u);
+  EXPECT_TRUE(s.media[0].sigma_s.is_black());
+  EXPECT_EQ(s.media[0].density.type, DensityDesc::Type::Constant);
+  EXPECT_EQ(s.media[0].density.scale, 1.0);
+  EXPECT_EQ(s.objects[0].shape_name, "inline");
+  EXPECT_EQ(s.objects[0].surface.type, SurfaceDesc::Type::Diffuse);
+  EXPECT_EQ(s.objects[0].surface.albedo, Rgb(0.5));
+  EXPECT_EQ(s.objects[1].surface.type, SurfaceDesc::Type::None);
+  EXPECT_EQ(s.objects[1].medium, 0);
+}
+
+TEST(SceneLoad, InlineShapesNestAndMayReferToNamedOnes) {
+  const SceneDesc s = load(with_camera(R"(
+      "shapes": {"ball": {"type": "sphere", "radius": 1}},
+      "objects": [{"shape": {"type": "difference",
+                             "shapes": ["ball", {"type": "halfspace", "normal": [0, 1, 0]}]}}])"));
+  const auto* csg = std::get_if<CsgNode>(&s.objects[0].shape->node);
+  ASSERT_NE(csg, nullptr);
+  EXPECT_EQ(csg->op, CsgOp::Difference);
+  ASSERT_EQ(csg->children.size(), 2u);
+  const auto* ball = std::get_if<QuadricNode>(&csg->children[0]->node);
+  ASSERT_NE(ball, nullptr);
+  EXPECT_EQ(ball->q.a, sphere({}, 1).a);
+  const auto* half = std::get_if<QuadricNode>(&csg->children[1]->node);
+  ASSERT_NE(half, nullptr);
+  EXPECT_EQ(half->q.a, halfspace({}, {0, 1, 0}).a);
+}
+
+// The quadric of a single-quadric shape, with its transform applied.
+Quadric world_quadric(const ShapePtr& s) {
+  return transformed(std::get<QuadricNode>(s->node).q, s->transform);
+}
+
+TEST(SceneLoad, TransformStepsApplyInListedOrder) {
+  const SceneDesc s = load(with_camera(R"("objects": [
+      {"shape": {"type": "sphere", "radius": 1,
+                 "transform": [{"scale": 2}, {"translate": [1, 0, 0]}]}},
+      {"shape": {"type": "sphere", "radius": 1,
+                 "transform": [{"translate": [1, 0, 0]}, {"scale": 2}]}},
+      {"shape": {"type": "ellipsoid", "radii": [2, 1, 1],
+                 "transform": [{"rotate": {"axis": [0, 0, 1], "degrees": 90}},
+                               {"translate": [0, 0, 5]}, {"scale": [1, 1, 0.5]}]}}])"));
+  // Scaled by 2, then moved: radius 2 around (1, 0, 0). F' = F(M⁻¹x) keeps F's value 1 at the
+  // centre.
+  const Quadric a = world_quadric(s.objects[0].shape);
+  EXPECT_NEAR(a.eval({1, 0, 0}), 1, 1e-12);
+  EXPECT_NEAR(a.eval({3, 0, 0}), 0, 1e-12);
+  EXPECT_NEAR(a.eval({1, -2, 0}), 0, 1e-12);
+  // Moved, then scaled about the origin: radius 2 around (2, 0, 0).
+  const Quadric b = world_quadric(s.objects[1].shape);
+  EXPECT_NEAR(b.eval({2, 0, 0}), 1, 1e-12);
+  EXPECT_NEAR(b.eval({4, 0, 0}), 0, 1e-12);
+  EXPECT_NEAR(b.eval({0, 0, 0}), 0, 1e-12);
+  // Long axis turned from x to y, centre moved to z = 5, then z halved: centre (0, 0, 2.5).
+  const Quadric c = world_quadric(s.objects[2].shape);
+  EXPECT_NEAR(c.eval({0, 0, 2.5}), 1, 1e-12);
+  EXPECT_NEAR(c.eval({0, 2, 2.5}), 0, 1e-12);
+  EXPECT_NEAR(c.eval({1, 0, 2.5}), 0, 1e-12);
+  EXPECT_NEAR(c.eval({0, 0, 3}), 0, 1e-12);
+}
+
+TEST(SceneLoad, TransformOfABoxAppliesToTheWholeBox) {
+  const SceneDesc s = load(with_camera(R"("objects": [
+      {"shape": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 1],
+                 "transform": [{"translate": [10, 0, 0]}]}}])"));
+  EXPECT_EQ(s.objects[0].shape->transform(0, 3), 10);
+  for (const ShapePtr& slab : std::get<CsgNode>(s.objects[0].shape->node).children)
+    EXPECT_EQ(slab->transform(0, 3), 0);
+}
+
+TEST(SceneLoad, OverridesReplaceAndCreateValues) {
+  const SceneDesc s =
+      load(kExample, {"integrator.spp=256", "camera.from=[1, 2, 3]", "camera.type=orthographic",
+                      "integrator.majorant.scale=1.5", "film.width=100", "film.width=200",
+                      "lights.0.radiance=[0.1, 0.2, 0.3]", R"(integrator.tracking="spectral-mis")",
+                      "integrator.octree={\"depth\": 3}"});
+  EXPECT_EQ(s.integrator.spp, 256);
+  EXPECT_EQ(s.camera.from, (Vec3{1, 2, 3}));
+  EXPECT_EQ(s.camera.type, CameraDesc::Type::Orthographic);
+  EXPECT_EQ(s.integrator.majorant.scale, 1.5);
+  EXPECT_EQ(s.film.width, 200);  // the last override wins
+  EXPECT_EQ(s.lights[0].radiance, Rgb({0.1, 0.2, 0.3}));
+  EXPECT_EQ(s.integrator.tracking, "spectral-mis");
+  EXPECT_EQ(s.integrator.octree.depth, 3);
+}
+
+TEST(SceneLoad, OverrideCreatesMissingSections) {
+  const SceneDesc s = load(with_camera(""), {"integrator.majorant.source=sample"});
+  EXPECT_EQ(s.integrator.majorant.source, "sample");
+}
+
+TEST(SceneLoad, OverrideReturnsTheEscapedPointer) {
+  nlohmann::json j = nlohmann::json::object();
+  EXPECT_EQ(apply_override(j, "shapes.a/b~c.radius=2"), "/shapes/a~1b~0c/radius");
+  EXPECT_EQ(j["shapes"]["a/b~c"]["radius"], 2);
+  EXPECT_EQ(apply_override(j, "note=two words"), "/note");
+  EXPECT_EQ(j["note"], "two words");
+}
+
+// Writes text to a file named scene.json in a fresh directory.
+class SceneFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() / ("nimbus_scene_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::string write(const std::string& text) {
+    const std::string path = (dir_ / "scene.json").string();
+    std::ofstream(path) << text;
+    return path;
+  }
+  std::filesystem::path dir_;
+};
+
+std::string file_error(const std::string& path) {
+  try {
+    load_scene_file(path);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST_F(SceneFileTest, FileLoadsWithComments) {
+  const std::string path = write(R"({
+    // Comments help explain scenes.
+    "camera": {"from": [0, 0, 5], "to": [0, 0, 0]} /* required */
+  })");
+  const SceneDesc s = load_scene_file(path, {"film.height=10"});
+  EXPECT_EQ(s.source, path);
+  EXPECT_EQ(s.film.height, 10);
+}
+
+TEST_F(SceneFileTest, SyntaxErrorGivesLineAndColumn) {
+  const std::string path = write("{\n  \"film\": {\n    width: 3}}");
+  const std::string message = file_error(path);
+  EXPECT_EQ(message.rfind(path + ": parse error at line 3, column 5: ", 0), 0u) << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos);
+}
+
+TEST_F(SceneFileTest, NumberOverflowIsAnError) {
+  const std::string path = write(R"({"film": {"width": 1e400}})");
+  EXPECT_EQ(file_error(path), path + ": number overflow parsing '1e400'");
+}
+
+TEST_F(SceneFileTest, MissingFileIsAnError) {
+  const std::string path = (dir_ / "none.json").string();
+  EXPECT_EQ(file_error(path), path + ": cannot open file (No such file or directory)");
+  EXPECT_EQ(file_error(dir_.string()), dir_.string() + ": cannot open file (is a directory)");
+}
+
+}  // namespace
+}  // namespace nimbus
