@@ -409,6 +409,15 @@ TEST(SceneLoad, NamedShapesAreBuiltOnceAndShared) {
   EXPECT_EQ(bump->q.a, (std::array<double, 10>{-4, -4, -4, 0, 0, 0, 0, 0, 4, -0.75}));
 }
 
+TEST(SceneLoad, ShapeDefinitionMayBeAnAlias) {
+  const SceneDesc s = load(with_camera(R"(
+      "shapes": {"a": "b", "b": {"type": "sphere", "radius": 1}},
+      "objects": [{"shape": "a"}, {"shape": "b"}])"));
+  EXPECT_EQ(s.objects[0].shape, s.objects[1].shape);
+  EXPECT_EQ(load_error(with_camera(R"("shapes": {"a": "b", "b": "a"})")),
+            "scene.json: /shapes/a: cycle in shape references: a -> b -> a");
+}
+
 TEST(SceneLoad, DefaultsApplyWhereKeysAreOptional) {
   const SceneDesc s = load(with_camera(R"(
       "media": {"m": {}},

@@ -310,7 +310,8 @@ class Loader {
       at.fail("cycle in shape references: " + chain + name);
     }
     resolving_.push_back({name, via});
-    ShapePtr s = inline_shape(*shapes_->optional(name));
+    // A definition may itself be just another shape's name: an alias.
+    ShapePtr s = shape(*shapes_->optional(name));
     resolving_.pop_back();
     built_[name] = s;
     return s;
