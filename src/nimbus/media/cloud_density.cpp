@@ -1,0 +1,49 @@
+#include "nimbus/media/cloud_density.h"
+
+#include <algorithm>
+
+namespace nimbus {
+namespace {
+
+constexpr Vec3 kWarpOffset[3] = {{5.2, 1.3, 7.7}, {1.7, 9.2, 3.1}, {8.3, 2.8, 4.6}};
+
+double profile(double F, double edge) {
+  const double u = std::clamp(F / edge, 0.0, 1.0);
+  return u * u * (3 - 2 * u);
+}
+
+// d = clamp((s − E)/(1 − E), 0, 1).
+double eroded(double s, double E) {
+  return std::clamp((s - E) / (1 - E), 0.0, 1.0);
+}
+
+double noise01(double n) {
+  return std::clamp(0.5 + kCloudContrast * n, 0.0, 1.0);
+}
+
+}  // namespace
+
+CloudDensity make_cloud_density(const CloudParams& params) {
+  return {params, make_noise(params.seed)};
+}
+
+double cloud_density(const CloudDensity& cloud, const Vec3& x, double F) {
+  const CloudParams& p = cloud.params;
+  const double s = profile(F, p.edge);
+  if (s <= 0) return 0;
+  const Vec3 q = p.frequency * x;
+  const Vec3 warp{fbm(cloud.noise, q + kWarpOffset[0], kCloudWarpOctaves),
+                  fbm(cloud.noise, q + kWarpOffset[1], kCloudWarpOctaves),
+                  fbm(cloud.noise, q + kWarpOffset[2], kCloudWarpOctaves)};
+  const double nu = noise01(fbm(cloud.noise, q + kCloudWarp * warp, p.octaves));
+  return eroded(s, p.amplitude * (1 - nu));
+}
+
+std::pair<double, double> cloud_density_range(double F_lo, double F_hi, const CloudParams& p) {
+  const double b = fbm_bound(p.octaves);
+  const double E_max = p.amplitude * (1 - noise01(-b));
+  const double E_min = p.amplitude * (1 - noise01(b));
+  return {eroded(profile(F_lo, p.edge), E_max), eroded(profile(F_hi, p.edge), E_min)};
+}
+
+}  // namespace nimbus

@@ -1,0 +1,59 @@
+#pragma once
+// Transmittance estimators along one segment [t0, t1] of a ray, for all N channels at once.
+//
+// Both sample tentative collisions t_i as a Poisson process of scalar rate mu_bar on [t0, t1]
+// and multiply per-channel ratios. Their expectation is exactly T = exp(−∫ mu_t) for any
+// mu_bar > 0 (the product over a Poisson process of (1 − f(t_i)/mu_bar) has expectation
+// exp(−∫ f)), so they stay unbiased when mu_bar does not bound mu_t: the weight then just goes
+// negative at some collisions. A bounding mu_bar keeps every factor in [0, 1].
+//
+// `lookup(t)` returns the MediumSample<N> at the point x(t) of the ray.
+
+#include "nimbus/math/rng.h"
+#include "nimbus/spectral/spectrum.h"
+#include "nimbus/tracking/counters.h"
+#include "nimbus/tracking/free_flight.h"
+#include "nimbus/tracking/medium_sample.h"
+
+namespace nimbus {
+
+// Ratio tracking (Cramer 1978; Novák, Selle & Jarosz 2014): T ≈ Π_i (1 − mu_t(t_i)/mu_bar).
+// mu_bar > 0; with mu_bar <= 0 no collision is sampled and 1 is returned, which is exact only
+// where the segment is empty.
+template <int N, class Lookup>
+Spectrum<N> ratio_tracking(Lookup&& lookup, double t0, double t1, double mu_bar, Rng& rng,
+                           TrackingCounters& counters) {
+  Spectrum<N> T(1.0);
+  if (!(mu_bar > 0)) return T;
+  for (double t = t0;;) {
+    t += free_flight(mu_bar, rng.uniform());
+    if (t >= t1) return T;
+    ++counters.tentative_collisions;
+    ++counters.lookups;
+    const MediumSample<N> m = lookup(t);
+    T *= Spectrum<N>(1.0) - m.mu_t() / mu_bar;
+    if (T.is_black()) return T;  // every later factor multiplies zero
+  }
+}
+
+// Residual ratio tracking (Novák, Selle & Jarosz 2014): with a control extinction mu_c, constant
+// on the segment, T = exp(−mu_c (t1 − t0)) · E[Π_i (1 − (mu_t(t_i) − mu_c)/mu_bar_r)], the
+// collisions sampled with rate mu_bar_r, a majorant of |mu_t − mu_c| over all channels. mu_c
+// need not be a minorant. With mu_bar_r <= 0 (no residual) the control term alone is returned.
+template <int N, class Lookup>
+Spectrum<N> residual_ratio_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>& mu_c,
+                                    double mu_bar_r, Rng& rng, TrackingCounters& counters) {
+  Spectrum<N> T = exp(mu_c * (t0 - t1));
+  if (!(mu_bar_r > 0)) return T;
+  for (double t = t0;;) {
+    t += free_flight(mu_bar_r, rng.uniform());
+    if (t >= t1) return T;
+    ++counters.tentative_collisions;
+    ++counters.lookups;
+    const MediumSample<N> m = lookup(t);
+    T *= Spectrum<N>(1.0) - (m.mu_t() - mu_c) / mu_bar_r;
+    if (T.is_black()) return T;
+  }
+}
+
+}  // namespace nimbus

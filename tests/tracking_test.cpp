@@ -1,0 +1,265 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+#include "nimbus/math/rng.h"
+#include "nimbus/tracking/delta_tracking.h"
+#include "nimbus/tracking/medium_sample.h"
+#include "nimbus/tracking/transmittance.h"
+#include "support/stats.h"
+
+namespace nimbus {
+namespace {
+
+constexpr double kT0 = 0.3, kT1 = 1.8;
+const Rgb kAlbedo{{0.9, 0.5, 0.2}};
+
+// An analytic heterogeneous medium along the segment: extinction per channel, its exact
+// integral, and per-channel bounds on [kT0, kT1].
+struct Profile {
+  const char* name;
+  std::function<Rgb(double)> mu_t;
+  std::function<Rgb(double, double)> optical_depth;  // ∫_{a}^{b} mu_t
+  Rgb lo, hi;
+
+  MediumSample<3> at(double t) const {
+    const Rgb m = mu_t(t);
+    return {m * (Rgb(1.0) - kAlbedo), m * kAlbedo, Rgb(0.0)};
+  }
+  Rgb transmittance() const { return exp(optical_depth(kT0, kT1) * -1.0); }
+  double majorant() const { return hi.max(); }
+};
+
+Rgb channel_min(const Rgb& x, const Rgb& y) {
+  Rgb r;
+  for (int i = 0; i < 3; ++i) r[i] = std::min(x[i], y[i]);
+  return r;
+}
+Rgb channel_max(const Rgb& x, const Rgb& y) {
+  Rgb r;
+  for (int i = 0; i < 3; ++i) r[i] = std::max(x[i], y[i]);
+  return r;
+}
+
+std::array<Profile, 3> profiles() {
+  const Rgb c{{1.0, 0.4, 2.2}};
+  const Rgb a{{0.2, 1.5, 0.1}}, b{{1.0, -0.5, 2.0}};
+  const Rgb A{{2.0, 1.0, 3.0}}, k{{3.0, 7.0, 1.5}}, base{{0.1, 0.5, 0.05}};
+  auto ramp = [=](double t) { return a + b * t; };
+  auto sin2 = [=](double t) {
+    Rgb m;
+    for (int i = 0; i < 3; ++i) m[i] = A[i] * std::pow(std::sin(k[i] * t), 2) + base[i];
+    return m;
+  };
+  return {{
+      {"homogeneous", [=](double) { return c; },
+       [=](double t0, double t1) { return c * (t1 - t0); }, c, c},
+      // mu_t = a + b t: ∫ = a (t1 − t0) + b (t1² − t0²)/2.
+      {"ramp", ramp,
+       [=](double t0, double t1) { return a * (t1 - t0) + b * (0.5 * (t1 * t1 - t0 * t0)); },
+       channel_min(ramp(kT0), ramp(kT1)), channel_max(ramp(kT0), ramp(kT1))},
+      // mu_t = A sin²(k t) + base: ∫ = A (t/2 − sin(2kt)/(4k)) + base t.
+      {"sin2", sin2,
+       [=](double t0, double t1) {
+         Rgb d;
+         for (int i = 0; i < 3; ++i) {
+           auto F = [&](double t) {
+             return A[i] * (0.5 * t - std::sin(2 * k[i] * t) / (4 * k[i])) + base[i] * t;
+           };
+           d[i] = F(t1) - F(t0);
+         }
+         return d;
+       },
+       base, A + base},
+  }};
+}
+
+// Per channel |mean − ref| / standard error over n estimates. A zero-variance estimator counts
+// as exact when it agrees with ref to rounding (1e-12), else as infinitely far.
+template <class Estimate>
+std::array<double, 3> z_scores(Estimate&& estimate, const Rgb& ref, int n) {
+  std::array<test::MeanVar, 3> mv;
+  for (int i = 0; i < n; ++i) {
+    const Rgb T = estimate();
+    for (int c = 0; c < 3; ++c) mv[c].add(T[c]);
+  }
+  std::array<double, 3> z;
+  for (int c = 0; c < 3; ++c) {
+    const double err = std::abs(mv[c].mean - ref[c]), se = mv[c].std_error();
+    z[c] = se > 0 ? err / se : (err < 1e-12 ? 0 : std::numeric_limits<double>::infinity());
+  }
+  return z;
+}
+
+constexpr int kEstimates = 40000;
+
+TEST(RatioTracking, MatchesAnalyticTransmittance) {
+  for (const Profile& p : profiles()) {
+    for (double scale : {1.0, 0.5}) {  // 0.5: the majorant does not bound mu_t
+      Rng rng(101, static_cast<uint64_t>(10 * scale));
+      TrackingCounters counters;
+      const double mu_bar = scale * p.majorant();
+      const auto z = z_scores(
+          [&] {
+            return ratio_tracking<3>([&](double t) { return p.at(t); }, kT0, kT1, mu_bar, rng,
+                                     counters);
+          },
+          p.transmittance(), kEstimates);
+      for (int c = 0; c < 3; ++c) EXPECT_LT(z[c], 4) << p.name << " scale " << scale << " ch " << c;
+      EXPECT_EQ(counters.lookups, counters.tentative_collisions);
+      EXPECT_EQ(counters.clamped, 0u);
+    }
+  }
+}
+
+TEST(RatioTracking, DetectsAFivePercentBias) {
+  // The 4-standard-error check has the power to reject a lookup that is 5% too dense.
+  const Profile p = profiles()[2];
+  Rng rng(102);
+  TrackingCounters counters;
+  const auto z = z_scores(
+      [&] {
+        return ratio_tracking<3>(
+            [&](double t) {
+              MediumSample<3> m = p.at(t);
+              m.mu_a *= 1.05;
+              m.mu_s *= 1.05;
+              return m;
+            },
+            kT0, kT1, 1.05 * p.majorant(), rng, counters);
+      },
+      p.transmittance(), kEstimates);
+  EXPECT_GT(*std::max_element(z.begin(), z.end()), 4);
+}
+
+TEST(RatioTracking, TentativeCollisionsArePoissonWithRateMuBar) {
+  const Profile p = profiles()[1];
+  const double mu_bar = 6.0;
+  Rng rng(103);
+  test::MeanVar collisions;
+  for (int i = 0; i < kEstimates; ++i) {
+    TrackingCounters counters;
+    // Heavy majorant: factors stay positive, so the product never hits zero early.
+    ratio_tracking<3>([&](double t) { return p.at(t); }, kT0, kT1, mu_bar, rng, counters);
+    collisions.add(double(counters.tentative_collisions));
+  }
+  EXPECT_NEAR(collisions.mean, mu_bar * (kT1 - kT0), 4 * collisions.std_error());
+}
+
+TEST(ResidualRatioTracking, MatchesAnalyticTransmittance) {
+  for (const Profile& p : profiles()) {
+    // Controls: the per-channel minorant, an achromatic minorant (the paper's choice) and the
+    // per-channel midpoint, which is no minorant (the residual changes sign).
+    const Rgb mid = (p.lo + p.hi) * 0.5;
+    for (const Rgb& mu_c : {p.lo, Rgb(p.lo.min()), mid}) {
+      double residual = 0;  // max over channels of |mu_t − mu_c| on the segment
+      for (int c = 0; c < 3; ++c)
+        residual = std::max({residual, std::abs(p.hi[c] - mu_c[c]), std::abs(p.lo[c] - mu_c[c])});
+      for (double scale : {1.0, 0.5}) {
+        Rng rng(104, static_cast<uint64_t>(10 * scale + 100 * mu_c[0]));
+        TrackingCounters counters;
+        const auto z = z_scores(
+            [&] {
+              return residual_ratio_tracking([&](double t) { return p.at(t); }, kT0, kT1, mu_c,
+                                             scale * residual, rng, counters);
+            },
+            p.transmittance(), kEstimates);
+        for (int c = 0; c < 3; ++c)
+          EXPECT_LT(z[c], 4) << p.name << " mu_c " << mu_c[c] << " scale " << scale << " ch " << c;
+      }
+    }
+  }
+}
+
+TEST(ResidualRatioTracking, ExactControlNeedsNoLookups) {
+  const Profile p = profiles()[0];
+  Rng rng(105);
+  TrackingCounters counters;
+  const Rgb T = residual_ratio_tracking([&](double t) { return p.at(t); }, kT0, kT1, p.lo, 0.0, rng,
+                                        counters);
+  for (int c = 0; c < 3; ++c) EXPECT_DOUBLE_EQ(T[c], p.transmittance()[c]);
+  EXPECT_EQ(counters.lookups, 0u);
+}
+
+TEST(DeltaTracking, EscapeProbabilityIsTransmittance) {
+  for (const Profile& p : profiles()) {
+    for (double scale : {1.0, 1.7}) {
+      for (int c = 0; c < 3; ++c) {
+        Rng rng(106, static_cast<uint64_t>(10 * scale + c));
+        TrackingCounters counters;
+        test::MeanVar escaped;
+        for (int i = 0; i < kEstimates; ++i) {
+          const Collision col = delta_tracking<3>([&](double t) { return p.at(t); }, kT0, kT1,
+                                                  scale * p.majorant(), c, rng, counters);
+          escaped.add(col.event == CollisionEvent::Escape);
+          if (col.event != CollisionEvent::Escape) {
+            EXPECT_GT(col.t, kT0);
+            EXPECT_LT(col.t, kT1);
+          }
+        }
+        EXPECT_NEAR(escaped.mean, p.transmittance()[c], 4 * escaped.std_error())
+            << p.name << " scale " << scale << " ch " << c;
+        EXPECT_EQ(counters.clamped, 0u);
+      }
+    }
+  }
+}
+
+TEST(DeltaTracking, HomogeneousDistancesAreExponentialAndEventsFollowAlbedo) {
+  const Rgb mu_a{{0.3, 1.2, 0.05}}, mu_s{{0.7, 0.4, 2.0}};
+  const MediumSample<3> m{mu_a, mu_s, Rgb(0.0)};
+  const double mu_bar = 2 * m.mu_t().max();  // plenty of null collisions
+  const double t0 = 0.5, inf = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < 3; ++c) {
+    const double mu_t = mu_a[c] + mu_s[c];
+    Rng rng(107, c);
+    TrackingCounters counters;
+    test::MeanVar scatter_distance, absorbed;
+    std::array<test::MeanVar, 3> below;  // P(s < x) over scatter distances s
+    const std::array<double, 3> x{0.3 / mu_t, 1.0 / mu_t, 2.5 / mu_t};
+    for (int i = 0; i < kEstimates; ++i) {
+      const Collision col =
+          delta_tracking<3>([&](double) { return m; }, t0, inf, mu_bar, c, rng, counters);
+      ASSERT_NE(col.event, CollisionEvent::Escape);
+      absorbed.add(col.event == CollisionEvent::Absorb);
+      if (col.event == CollisionEvent::Scatter) {
+        const double s = col.t - t0;
+        scatter_distance.add(s);
+        for (int k = 0; k < 3; ++k) below[k].add(s < x[k]);
+      }
+    }
+    EXPECT_NEAR(absorbed.mean, mu_a[c] / mu_t, 4 * absorbed.std_error()) << c;
+    EXPECT_NEAR(scatter_distance.mean, 1 / mu_t, 4 * scatter_distance.std_error()) << c;
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(below[k].mean, 1 - std::exp(-mu_t * x[k]), 4 * below[k].std_error()) << c;
+    // On average mu_bar/mu_t tentative collisions per real one.
+    EXPECT_NEAR(double(counters.tentative_collisions) / kEstimates, mu_bar / mu_t,
+                0.05 * mu_bar / mu_t);
+    EXPECT_EQ(counters.clamped, 0u);
+  }
+}
+
+TEST(DeltaTracking, NonBoundingMajorantClampsAndSaysSo) {
+  // With mu_bar = mu_t / 2 every tentative collision is real after clamping, so free paths
+  // follow mu_bar instead of mu_t: escape probability exp(−mu_bar L), not exp(−mu_t L).
+  const MediumSample<3> m{Rgb(0.4), Rgb(0.6), Rgb(0.0)};
+  const double mu_t = 1.0, mu_bar = 0.5, L = kT1 - kT0;
+  Rng rng(108);
+  TrackingCounters counters;
+  test::MeanVar escaped;
+  for (int i = 0; i < kEstimates; ++i)
+    escaped.add(
+        delta_tracking<3>([&](double) { return m; }, kT0, kT1, mu_bar, 0, rng, counters).event ==
+        CollisionEvent::Escape);
+  EXPECT_EQ(counters.clamped, counters.tentative_collisions);
+  EXPECT_GT(counters.clamped, 0u);
+  EXPECT_NEAR(escaped.mean, std::exp(-mu_bar * L), 4 * escaped.std_error());
+  EXPECT_GT(std::abs(escaped.mean - std::exp(-mu_t * L)), 4 * escaped.std_error());
+}
+
+}  // namespace
+}  // namespace nimbus
