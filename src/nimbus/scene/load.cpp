@@ -133,9 +133,8 @@ class Loader {
     if (dot(view, view) == 0) to.fail(R"(must differ from "from")");
     // Parallel within about 1e-6 radians would give a camera frame made of round-off.
     if (length(cross(normalize(view), normalize(c.up))) < 1e-6) {
-      const std::string problem = "must not be parallel to the view direction";
-      if (up) up->fail(problem);
-      o.fail(fmt::format("up: {} (the default up is [0, 1, 0]; give another)", problem));
+      if (up) up->fail("must not be parallel to the view direction");
+      o.fail(R"(the view direction is parallel to the default up [0, 1, 0]; give "up")");
     }
     return c;
   }
@@ -175,6 +174,7 @@ class Loader {
     JsonObject o(v);
     LightDesc l;
     const JsonValue type = o.required("type");
+    // In the order of LightDesc::Type, so that an index is the enumerator.
     const size_t kind =
         type.choice("light type", {"environment", "directional", "point", "sphere"});
     l.type = static_cast<LightDesc::Type>(kind);
