@@ -17,7 +17,8 @@
 //   F ∈ [F_lo, F_hi], with ν in the interval given by the global bound |fbm| <= fbm_bound:
 //   d ∈ [d(s(F_lo), E_max), d(s(F_hi), E_min)] (cloud_density_range).
 // Near the surface (s < amplitude) the noise eats the profile away where ν is low: billowy
-// edges and holes; deeper in, s > amplitude keeps the core filled but textured.
+// edges and holes. Deeper in (s > amplitude) the core is never empty but still textured, and
+// where F >= edge (s = 1) the density is exactly 1.
 
 #include <cstdint>
 #include <utility>

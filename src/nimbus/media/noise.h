@@ -10,7 +10,8 @@
 // so Σ_c w_c |t − c|² = Σ_i h(t_i) with h(t) = (1 − S(t)) t² + S(t)(1 − t)² = t² + S(t)(1 − 2t).
 // S(t) <= t on [0, 1/2] (S(t)/t = 6t⁴ − 15t³ + 10t² increases there to 1) and S(t) = 1 − S(1 − t),
 // so S(t)(1 − 2t) <= t(1 − 2t) on all of [0, 1] and h(t) <= t(1 − t) <= 1/4. Hence
-// |noise| <= (3/4)^{1/2}. The bound is attained when all eight gradients point at the cell centre.
+// |noise| <= (3/4)^{1/2}. The bound is attainable: at a cell centre whose eight gradients all point
+// at it.
 //
 // fbm(x, K) = Σ_{k<K} gain^k noise(lacunarity^k x + k·shift), lacunarity 2, gain 1/2, and
 // |fbm| <= B Σ_{k<K} 2^{−k} = B (2 − 2^{1−K}) = fbm_bound(K). The per-octave shift only moves

@@ -108,7 +108,7 @@ class JsonObject {
   std::vector<std::pair<std::string, JsonValue>> entries();
 
   // Fails at the first key that was never asked for with `unknown key` (plus `context`, e.g.
-  // "for a point light"), adding `(did you mean "x"?)` when an asked-for key is a likely
+  // `for light type "point"`), adding `(did you mean "x"?)` when an asked-for key is a likely
   // intended spelling.
   void finish(std::string_view context = {}) const;
 

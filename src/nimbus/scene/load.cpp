@@ -133,9 +133,8 @@ class Loader {
     if (dot(view, view) == 0) to.fail(R"(must differ from "from")");
     // Parallel within about 1e-6 radians would give a camera frame made of round-off.
     if (length(cross(normalize(view), normalize(c.up))) < 1e-6) {
-      const std::string problem = "must not be parallel to the view direction";
-      if (up) up->fail(problem);
-      o.fail(fmt::format("up: {} (the default up is [0, 1, 0]; give another)", problem));
+      if (up) up->fail("must not be parallel to the view direction");
+      o.fail(R"(the view direction is parallel to the default up [0, 1, 0]; give "up")");
     }
     return c;
   }
@@ -175,6 +174,7 @@ class Loader {
     JsonObject o(v);
     LightDesc l;
     const JsonValue type = o.required("type");
+    // In the order of LightDesc::Type, so that an index is the enumerator.
     const size_t kind =
         type.choice("light type", {"environment", "directional", "point", "sphere"});
     l.type = static_cast<LightDesc::Type>(kind);
@@ -196,7 +196,7 @@ class Loader {
         l.radiance = o.required("radiance").rgb(at_least(0));
         break;
     }
-    o.finish(fmt::format("for a {} light", type.string()));
+    o.finish(fmt::format("for light type \"{}\"", type.string()));
     return l;
   }
 
@@ -216,7 +216,7 @@ class Loader {
       }
       if (type == "hg")
         if (auto g = p.optional("g")) m.phase.g = g->number(strictly_between(-1, 1));
-      p.finish(fmt::format("for an {} phase function", type));
+      p.finish(fmt::format("for phase type \"{}\"", type));
     }
     if (auto x = o.optional("density")) {
       JsonObject d(*x);
@@ -235,7 +235,7 @@ class Loader {
           m.density.amplitude = y->number(Range{0.0, 1.0, true, false});
         if (auto y = d.optional("seed")) m.density.seed = y->unsigned_integer();
       }
-      d.finish(fmt::format("for a {} density", type));
+      d.finish(fmt::format("for density type \"{}\"", type));
     }
     o.finish();
     return m;
@@ -277,7 +277,8 @@ class Loader {
           obj.surface.radiance = so.required("radiance").rgb(at_least(0));
           break;
       }
-      so.finish(fmt::format("for a {} surface", kSurfaceTypes[static_cast<int>(obj.surface.type)]));
+      so.finish(fmt::format("for surface type \"{}\"",
+                            kSurfaceTypes[static_cast<int>(obj.surface.type)]));
     }
     o.finish();
     if (obj.surface.type == SurfaceDesc::Type::None && !medium)
@@ -404,7 +405,7 @@ class Loader {
       s = make_shape(std::move(node));
     }
     const auto transform = o.optional("transform");
-    o.finish(fmt::format("for a {}", kind));
+    o.finish(fmt::format("for shape type \"{}\"", kind));
     return transform ? with_transform(s, read_transform(*transform)) : s;
   }
 
