@@ -1,0 +1,132 @@
+#include "nimbus/frep/tape.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <variant>
+
+#include "nimbus/frep/tape_eval.h"
+
+namespace nimbus {
+namespace {
+
+class Compiler {
+ public:
+  explicit Compiler(Tape& tape) : tape_(tape) {}
+
+  // Emits code leaving the node's F in register `reg`, with registers above it as scratch.
+  // `parent` is the composed object-to-world transform of the node's ancestors.
+  void emit(const ShapeDesc& shape, const Mat4& parent, int reg) {
+    if (reg >= kMaxRegisters) throw std::invalid_argument("compile: shape nested too deeply");
+    tape_.num_registers = std::max(tape_.num_registers, reg + 1);
+    const Mat4 world = parent * shape.transform;
+    std::visit([&](const auto& node) { emit_node(node, world, reg); }, shape.node);
+  }
+
+ private:
+  void emit_child(const ShapePtr& child, const Mat4& world, int reg) {
+    if (!child) throw std::invalid_argument("compile: null shape");
+    emit(*child, world, reg);
+  }
+
+  void emit_node(const QuadricNode& node, const Mat4& world, int reg) {
+    const auto index = static_cast<std::uint32_t>(tape_.quadrics.size());
+    tape_.quadrics.push_back(transformed(node.q, world));
+    push({Op::Quadric, reg16(reg), 0, index, 0});
+  }
+
+  void emit_node(const FreeFormNode& node, const Mat4& world, int reg) {
+    emit_child(node.base, world, reg);
+    for (const Perturbation& p : node.perturbations) {
+      if (!p.shape) throw std::invalid_argument("compile: null perturbation");
+      // A zero weight leaves F unchanged (eq. 1); do not pay for it.
+      if (p.weight == 0) continue;
+      emit(*p.shape, world, reg + 1);
+      push({Op::AddCubePos, reg16(reg), reg16(reg + 1), 0, p.weight});
+    }
+  }
+
+  void emit_node(const CsgNode& node, const Mat4& world, int reg) {
+    if (node.children.empty()) throw std::invalid_argument("compile: empty CSG node");
+    emit_child(node.children[0], world, reg);
+    for (size_t i = 1; i < node.children.size(); ++i) {
+      emit_child(node.children[i], world, reg + 1);
+      switch (node.op) {
+        case CsgOp::Union:
+          push({Op::Max, reg16(reg), reg16(reg + 1), 0, 0});
+          break;
+        case CsgOp::Intersection:
+          push({Op::Min, reg16(reg), reg16(reg + 1), 0, 0});
+          break;
+        case CsgOp::Difference:
+          push({Op::Neg, reg16(reg + 1), 0, 0, 0});
+          push({Op::Min, reg16(reg), reg16(reg + 1), 0, 0});
+          break;
+      }
+    }
+  }
+
+  static std::uint16_t reg16(int reg) { return static_cast<std::uint16_t>(reg); }
+  void push(const Instr& in) { tape_.code.push_back(in); }
+
+  Tape& tape_;
+};
+
+// FlatFreeForm: Quadric(r0) followed by pairs Quadric(r1), AddCubePos(r0 += w · r1).
+TapeKind classify(const Tape& tape, std::vector<double>& weights) {
+  const auto& code = tape.code;
+  if (code.size() == 1) return TapeKind::SingleQuadric;
+  const size_t perturbations = (code.size() - 1) / 2;
+  if (code.size() % 2 == 0 || perturbations > kMaxFlatPerturbations) return TapeKind::General;
+  for (size_t i = 0; i < perturbations; ++i) {
+    const Instr& load = code[1 + 2 * i];
+    const Instr& add = code[2 + 2 * i];
+    if (load.op != Op::Quadric || add.op != Op::AddCubePos) return TapeKind::General;
+    weights.push_back(add.weight);
+  }
+  return TapeKind::FlatFreeForm;
+}
+
+// The box first_hit clips rays to: the bounds grown by a relative 1e-9 so that rounding in the
+// clip never shaves off a crossing on a tight face, or a huge cube for unbounded shapes.
+Box search_box(const Bounds& bounds) {
+  const Box world{{-kUnboundedExtent, -kUnboundedExtent, -kUnboundedExtent},
+                  {kUnboundedExtent, kUnboundedExtent, kUnboundedExtent}};
+  if (!bounds.bounded) return intersect(bounds.box, world);
+  if (bounds.box.empty()) return bounds.box;
+  const double pad = 1e-9 * length(bounds.box.extent()) + 1e-300;
+  return {bounds.box.lo - Vec3{pad, pad, pad}, bounds.box.hi + Vec3{pad, pad, pad}};
+}
+
+}  // namespace
+
+Tape compile(const ShapeDesc& shape) {
+  Tape tape;
+  Compiler(tape).emit(shape, Mat4::identity(), 0);
+  tape.kind = classify(tape, tape.weights);
+  if (tape.kind != TapeKind::FlatFreeForm) tape.weights.clear();
+  tape.bounds = compute_bounds(tape);
+  tape.search_box = search_box(tape.bounds);
+  const double diagonal = length(tape.search_box.extent());
+  tape.size = std::isfinite(diagonal) && diagonal > 0 ? diagonal : 1.0;
+  return tape;
+}
+
+double evaluate(const Tape& tape, const Vec3& p) {
+  return run_tape<double>(tape, [&](std::uint32_t i) { return tape.quadrics[i].eval(p); });
+}
+
+Vec3 gradient(const Tape& tape, const Vec3& p) {
+  return run_tape<DualGrad>(tape,
+                            [&](std::uint32_t i) {
+                              const Quadric& q = tape.quadrics[i];
+                              return DualGrad{q.eval(p), q.gradient(p)};
+                            })
+      .grad;
+}
+
+Interval evaluate(const Tape& tape, const Box& box) {
+  return run_tape<Interval>(tape,
+                            [&](std::uint32_t i) { return quadric_range(tape.quadrics[i], box); });
+}
+
+}  // namespace nimbus

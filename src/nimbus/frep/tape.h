@@ -1,0 +1,71 @@
+#pragma once
+// A shape compiled to a flat instruction tape (as libfive does): transforms are folded into
+// world-space quadric coefficients, and the tree becomes a register program that evaluates
+// F (> 0 inside) at a point, over a box, or along a ray, with one template interpreter
+// (tape_eval.h).
+
+#include <cstdint>
+#include <vector>
+
+#include "nimbus/frep/bounds.h"
+#include "nimbus/frep/quadric.h"
+#include "nimbus/frep/shape_desc.h"
+#include "nimbus/math/box.h"
+#include "nimbus/math/interval.h"
+#include "nimbus/math/vec3.h"
+
+namespace nimbus {
+
+// Registers are the nesting depth of the tree; this many suffice for any sane scene.
+constexpr int kMaxRegisters = 32;
+// A free form with more quadric perturbations than this is intersected by the general path.
+constexpr int kMaxFlatPerturbations = 64;
+
+enum class Op : std::uint8_t {
+  Quadric,     // r[dst] = quadrics[quadric](x)
+  Max,         // r[dst] = max(r[dst], r[src])           (union)
+  Min,         // r[dst] = min(r[dst], r[src])           (intersection, difference)
+  Neg,         // r[dst] = −r[dst]                        (difference's subtrahends)
+  AddCubePos,  // r[dst] += weight · max(r[src], 0)³     (a perturbation, eq. 1–2)
+};
+
+struct Instr {
+  Op op = Op::Quadric;
+  std::uint16_t dst = 0;
+  std::uint16_t src = 0;
+  std::uint32_t quadric = 0;
+  double weight = 0;
+};
+
+enum class TapeKind : std::uint8_t {
+  SingleQuadric,  // one quadric: analytic roots
+  FlatFreeForm,   // quadric base + quadric perturbations: piecewise polynomial of degree <= 6
+  General,        // anything else: interval subdivision along the ray
+};
+
+struct Tape {
+  std::vector<Quadric> quadrics;  // world space
+  std::vector<Instr> code;        // the result is register 0
+  int num_registers = 0;
+  TapeKind kind = TapeKind::General;
+  // FlatFreeForm only: quadrics[0] is the base, quadrics[i + 1] has weight weights[i].
+  std::vector<double> weights;
+  Bounds bounds;
+  // Where first_hit looks: the bounds padded against round-off, or, for an unbounded shape,
+  // its box cut to |x_i| <= kUnboundedExtent (the scene loader clips those anyway).
+  Box search_box;
+  // A length for tolerances: the search box's diagonal.
+  double size = 1;
+};
+
+constexpr double kUnboundedExtent = 1e6;
+
+// Throws std::invalid_argument on a null shape, an empty CSG node or nesting deeper than
+// kMaxRegisters; otherwise assumes a valid tree (the scene loader checks it).
+Tape compile(const ShapeDesc& shape);
+
+double evaluate(const Tape& tape, const Vec3& p);     // F(p), > 0 inside
+Vec3 gradient(const Tape& tape, const Vec3& p);       // ∇F(p), forward mode; points inward
+Interval evaluate(const Tape& tape, const Box& box);  // encloses F over the box
+
+}  // namespace nimbus
