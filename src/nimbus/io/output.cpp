@@ -39,6 +39,10 @@ void write_image(const std::string& path, const Image& image) {
 
 void check_output_path(const std::string& path) {
   format_of(path);
+  check_writable_path(path);
+}
+
+void check_writable_path(const std::string& path) {
   namespace fs = std::filesystem;
   const fs::path parent = fs::path(path).parent_path();
   const fs::path dir = parent.empty() ? fs::path(".") : parent;

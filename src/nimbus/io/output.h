@@ -16,4 +16,8 @@ void write_image(const std::string& path, const Image& image);
 // and is writable, and the path is not itself a directory.
 void check_output_path(const std::string& path);
 
+// The same check for a file of any kind: the directory exists and is writable, and the path is
+// not itself a directory.
+void check_writable_path(const std::string& path);
+
 }  // namespace nimbus

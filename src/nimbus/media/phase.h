@@ -8,12 +8,11 @@
 
 #include <numbers>
 
+#include "nimbus/math/constants.h"
 #include "nimbus/math/vec3.h"
 
 namespace nimbus {
 
-// 1/(4π): the isotropic phase function.
-inline constexpr double kInv4Pi = 0.25 * std::numbers::inv_pi;
 
 // p_HG(cos θ) = (1 − g²) / (4π (1 + g² − 2 g cos θ)^{3/2}), |g| < 1; g = 0 gives 1/(4π).
 double hg_phase(double cos_theta, double g);

@@ -232,7 +232,8 @@ class Loader {
         if (auto y = d.optional("octaves")) m.density.octaves = y->integer(between(1, 16));
         if (auto y = d.optional("frequency")) m.density.frequency = y->number(above(0));
         if (auto y = d.optional("amplitude"))
-          m.density.amplitude = y->number(Range{0.0, 1.0, true, false});
+          m.density.amplitude = y->number(Range{0.0, 1.0, false, true});
+        if (auto y = d.optional("edge")) m.density.edge = y->number(above(0));
         if (auto y = d.optional("seed")) m.density.seed = y->unsigned_integer();
       }
       d.finish(fmt::format("for density type \"{}\"", type));

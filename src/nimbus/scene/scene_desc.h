@@ -65,11 +65,12 @@ struct DensityDesc {
   enum class Type { Constant, Field, Cloud };
   Type type = Type::Constant;
   double scale = 1;
-  // Cloud noise: fractal sum of `octaves` noise octaves starting at `frequency`, each octave's
-  // amplitude `amplitude` times the previous one's.
+  // Cloud (docs/media.md): noise octaves and base frequency, erosion depth in [0, 1), seed, and
+  // the F over which the profile rises from 0 to 1.
   int octaves = 5;
   double frequency = 2, amplitude = 0.6;
   uint64_t seed = 0;
+  double edge = 1;
 };
 
 struct MediumDesc {

@@ -1,0 +1,11 @@
+#pragma once
+
+#include <numbers>
+
+namespace nimbus {
+
+inline constexpr double kPi = std::numbers::pi;
+inline constexpr double kInvPi = std::numbers::inv_pi;
+inline constexpr double kInv4Pi = 0.25 * std::numbers::inv_pi;  // the isotropic phase function
+
+}  // namespace nimbus

@@ -1,0 +1,21 @@
+#pragma once
+// A participating medium at run time: coefficients per unit length, a phase function and a
+// density model. The medium at x is density(x) · (sigma_a, sigma_s), emitting L_e.
+
+#include "nimbus/media/cloud_density.h"
+#include "nimbus/spectral/spectrum.h"
+
+namespace nimbus {
+
+struct Medium {
+  enum class Density { Constant, Field, Cloud };
+  Rgb sigma_a{0.0}, sigma_s{0.0};
+  Rgb emission{0.0};  // L_e, entering the RTE as mu_a L_e (eq. 4)
+  double g = 0;       // Henyey–Greenstein asymmetry; 0 is isotropic
+  Density density = Density::Constant;
+  double scale = 1;        // multiplies every density model
+  CloudDensity cloud;      // Cloud: density from F and noise
+  double density_max = 1;  // an upper bound of the density over the object
+};
+
+}  // namespace nimbus

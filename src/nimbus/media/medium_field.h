@@ -1,0 +1,55 @@
+#pragma once
+// The medium as a field (DESIGN.md): wherever an index-matched object's function is positive its
+// medium is present, and overlapping media add. Inside a solid object (a dielectric with a
+// medium) only that object's medium is present: a solid displaces the media around it.
+
+#include <array>
+#include <vector>
+
+#include "nimbus/math/ray.h"
+#include "nimbus/media/medium.h"
+#include "nimbus/spectral/spectrum.h"
+
+namespace nimbus {
+
+struct Scene;
+
+// The coefficients at a point, with the phase function of the mixture of media present there.
+struct MediumPoint {
+  static constexpr int kMaxMedia = 8;
+  Rgb mu_a{0.0}, mu_s{0.0};
+  Rgb mu_a_Le{0.0};  // Σ mu_a,i L_e,i
+  int media = 0;     // how many media contribute
+  std::array<double, kMaxMedia> g{};
+  std::array<Rgb, kMaxMedia> mu_s_i{};  // each medium's scattering coefficient
+  Rgb mu_t() const { return mu_a + mu_s; }
+};
+
+// `inside` is the solid object the point is in (-1: none).
+MediumPoint medium_at(const Scene& scene, const Vec3& x, int inside);
+
+// A stretch of a ray with a majorant of mu_t that holds there, per channel.
+struct MajorantSegment {
+  double t0, t1;
+  Rgb mu_bar;
+};
+
+// Majorant segments covering the media along the ray in [t_min, t_max], in order, with gaps
+// where no medium can be. At most kMaxSegments; the ray direction must be unit length.
+struct MajorantSegments {
+  static constexpr int kMaxSegments = 2 * MediumPoint::kMaxMedia + 1;
+  std::array<MajorantSegment, kMaxSegments> seg;
+  int count = 0;
+};
+MajorantSegments majorant_segments(const Scene& scene, const Ray& ray, double t_min, double t_max,
+                                   int inside);
+
+// The mixture phase function at a scattering point: value per channel and its sampling.
+Rgb phase_value(const MediumPoint& m, double cos_theta);
+// Picks a medium with probability ∝ its average mu_s, then samples its HG lobe; returns the
+// direction and the per-channel weight phase_value / pdf (exactly 1 for a single medium).
+Vec3 sample_phase(const MediumPoint& m, const Vec3& dir, double u0, double u1, double u2,
+                  Rgb& weight, double& pdf);
+double phase_pdf(const MediumPoint& m, double cos_theta);
+
+}  // namespace nimbus

@@ -1,0 +1,31 @@
+#pragma once
+// Per-thread event counters, merged at the end of a render and reported in --stats.
+
+#include <cstdint>
+
+#include "nimbus/tracking/counters.h"
+
+namespace nimbus {
+
+struct Counters {
+  uint64_t paths = 0;
+  uint64_t surface_rays = 0;  // closest-hit queries
+  uint64_t shadow_rays = 0;
+  uint64_t real_collisions = 0;  // scattering or absorption events in media
+  uint64_t scatter_events = 0;   // real scattering events in media
+  TrackingCounters tracking;     // tentative collisions, density lookups, clamped probabilities
+
+  uint64_t null_collisions() const { return tracking.tentative_collisions - real_collisions; }
+
+  Counters& operator+=(const Counters& o) {
+    paths += o.paths;
+    surface_rays += o.surface_rays;
+    shadow_rays += o.shadow_rays;
+    real_collisions += o.real_collisions;
+    scatter_events += o.scatter_events;
+    tracking += o.tracking;
+    return *this;
+  }
+};
+
+}  // namespace nimbus

@@ -1,0 +1,43 @@
+#include "nimbus/render/film.h"
+
+#include <cmath>
+#include <numeric>
+
+namespace nimbus {
+
+Rgb Film::variance_of_mean(int pixel) const {
+  if (spp < 2) return Rgb(0.0);
+  const Rgb m = mean(pixel);
+  Rgb var = (sum_sq[pixel] / double(spp) - m * m) * (double(spp) / double(spp - 1));
+  for (int c = 0; c < 3; ++c) var[c] = std::max(0.0, var[c]);
+  return var / double(spp);
+}
+
+Image to_image(const Film& film) {
+  Image img{film.width, film.height, std::vector<float>(size_t(film.width) * film.height * 3)};
+  for (int p = 0; p < film.width * film.height; ++p) {
+    const Rgb m = film.mean(p);
+    for (int c = 0; c < 3; ++c) img.rgb[3 * size_t(p) + c] = static_cast<float>(m[c]);
+  }
+  return img;
+}
+
+MeanEstimate region_mean(const Film& film, const std::vector<int>& pixels) {
+  Rgb mean(0.0), var(0.0);
+  for (int p : pixels) {
+    mean += film.mean(p);
+    var += film.variance_of_mean(p);
+  }
+  const double n = static_cast<double>(pixels.size());
+  MeanEstimate e{mean / n, Rgb(0.0)};
+  for (int c = 0; c < 3; ++c) e.standard_error[c] = std::sqrt(var[c]) / n;
+  return e;
+}
+
+MeanEstimate image_mean(const Film& film) {
+  std::vector<int> all(size_t(film.width) * film.height);
+  std::iota(all.begin(), all.end(), 0);
+  return region_mean(film, all);
+}
+
+}  // namespace nimbus

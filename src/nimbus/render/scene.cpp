@@ -1,0 +1,51 @@
+#include "nimbus/render/scene.h"
+
+#include <cmath>
+
+namespace nimbus {
+
+std::optional<SurfaceHit> intersect(const Scene& scene, const Ray& ray, double t_max) {
+  std::optional<SurfaceHit> best;
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const SceneObject& obj = scene.objects[i];
+    if (obj.surface.type == Surface::Type::None) continue;
+    double t0 = 0, t1 = t_max;
+    if (!clip_ray(obj.bounds, ray, t0, t1)) continue;
+    if (auto t = first_hit(obj.tape, ray, t0, t1)) {
+      t_max = *t;
+      best = SurfaceHit{*t, static_cast<int>(i), -1};
+    }
+  }
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    if (scene.lights[i].type != Light::Type::Sphere) continue;
+    if (auto t = intersect_sphere_light(scene.lights[i], ray, 0, t_max)) {
+      t_max = *t;
+      best = SurfaceHit{*t, -1, static_cast<int>(i)};
+    }
+  }
+  return best;
+}
+
+bool occluded(const Scene& scene, const Ray& ray, double t_max) {
+  for (const SceneObject& obj : scene.objects) {
+    if (obj.surface.type == Surface::Type::None) continue;
+    double t0 = 0, t1 = t_max;
+    if (!clip_ray(obj.bounds, ray, t0, t1)) continue;
+    if (first_hit(obj.tape, ray, t0, t1)) return true;
+  }
+  for (const Light& l : scene.lights)
+    if (l.type == Light::Type::Sphere && intersect_sphere_light(l, ray, 0, t_max)) return true;
+  return false;
+}
+
+Vec3 outward_normal(const SceneObject& object, const Vec3& p) {
+  return normalize(-gradient(object.tape, p));
+}
+
+Vec3 offset_origin(const Scene& scene, const Vec3& p, const Vec3& n, const Vec3& w) {
+  const double eps =
+      1e-7 * std::max({1.0, scene.scale, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+  return dot(n, w) >= 0 ? p + n * eps : p - n * eps;
+}
+
+}  // namespace nimbus

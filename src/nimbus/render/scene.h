@@ -1,0 +1,60 @@
+#pragma once
+// The compiled scene: flat, immutable, shared read-only by every thread.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "nimbus/frep/intersect.h"
+#include "nimbus/frep/tape.h"
+#include "nimbus/math/box.h"
+#include "nimbus/media/medium.h"
+#include "nimbus/render/camera.h"
+#include "nimbus/render/light.h"
+#include "nimbus/render/material.h"
+
+namespace nimbus {
+
+struct RenderSettings {
+  int width = 640, height = 480;
+  int spp = 16;
+  uint64_t seed = 0;
+  int max_depth = 1000;
+};
+
+struct SceneObject {
+  Tape tape;
+  Box bounds;  // finite, conservative
+  Surface surface;
+  int medium = -1;
+};
+
+struct Scene {
+  Camera camera;
+  RenderSettings settings;
+  std::vector<SceneObject> objects;
+  std::vector<Light> lights;
+  std::vector<Medium> media;
+  std::vector<int> field_objects;  // index-matched objects (surface none) holding a medium
+  double scale = 1;                // size of the scene's bounds, for ray offsets
+};
+
+struct SurfaceHit {
+  double t = 0;
+  int object = -1;  // index into objects, or -1
+  int light = -1;   // index of a sphere light, or -1
+};
+
+// Closest surface (objects with a surface, and sphere lights) along the ray in (0, t_max).
+std::optional<SurfaceHit> intersect(const Scene& scene, const Ray& ray, double t_max);
+// Whether any surface blocks the ray in (0, t_max); media do not block.
+bool occluded(const Scene& scene, const Ray& ray, double t_max);
+
+// The outward unit normal of an object at a point on its surface (F decreases outwards).
+Vec3 outward_normal(const SceneObject& object, const Vec3& p);
+
+// A point just off the surface on the side that w points to, so the next ray starts clear of it.
+Vec3 offset_origin(const Scene& scene, const Vec3& p, const Vec3& n, const Vec3& w);
+
+}  // namespace nimbus

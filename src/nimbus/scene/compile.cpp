@@ -1,0 +1,162 @@
+#include "nimbus/scene/compile.h"
+
+#include <fmt/format.h>
+
+#include "nimbus/frep/bounds.h"
+#include "nimbus/media/medium_field.h"
+#include "nimbus/scene/load.h"
+
+namespace nimbus {
+namespace {
+
+Camera compile_camera(const CameraDesc& c, const FilmDesc& film) {
+  if (c.type == CameraDesc::Type::Orthographic)
+    return orthographic_camera(c.from, c.to, c.up, c.width, film.width, film.height);
+  return perspective_camera(c.from, c.to, c.up, c.fov, film.width, film.height);
+}
+
+Light compile_light(const LightDesc& d) {
+  Light l;
+  switch (d.type) {
+    case LightDesc::Type::Environment:
+      l.type = Light::Type::Environment;
+      break;
+    case LightDesc::Type::Directional:
+      l.type = Light::Type::Directional;
+      break;
+    case LightDesc::Type::Point:
+      l.type = Light::Type::Point;
+      break;
+    case LightDesc::Type::Sphere:
+      l.type = Light::Type::Sphere;
+      break;
+  }
+  l.radiance = d.radiance;
+  l.irradiance = d.irradiance;
+  l.intensity = d.intensity;
+  l.direction = d.type == LightDesc::Type::Directional ? normalize(d.direction) : d.direction;
+  l.position = d.position;
+  l.center = d.center;
+  l.radius = d.radius;
+  return l;
+}
+
+Surface compile_surface(const SurfaceDesc& d) {
+  Surface s;
+  switch (d.type) {
+    case SurfaceDesc::Type::None:
+      s.type = Surface::Type::None;
+      break;
+    case SurfaceDesc::Type::Diffuse:
+      s.type = Surface::Type::Diffuse;
+      break;
+    case SurfaceDesc::Type::Dielectric:
+      s.type = Surface::Type::Dielectric;
+      break;
+    case SurfaceDesc::Type::Emissive:
+      s.type = Surface::Type::Emissive;
+      break;
+  }
+  s.albedo = d.albedo;
+  s.ior = d.ior;
+  s.radiance = d.radiance;
+  return s;
+}
+
+Medium compile_medium(const MediumDesc& d) {
+  Medium m;
+  m.sigma_a = d.sigma_a;
+  m.sigma_s = d.sigma_s;
+  m.emission = d.emission;
+  m.g = d.phase.type == PhaseDesc::Type::HenyeyGreenstein ? d.phase.g : 0.0;
+  switch (d.density.type) {
+    case DensityDesc::Type::Constant:
+      m.density = Medium::Density::Constant;
+      break;
+    case DensityDesc::Type::Field:
+      m.density = Medium::Density::Field;
+      break;
+    case DensityDesc::Type::Cloud:
+      m.density = Medium::Density::Cloud;
+      break;
+  }
+  m.scale = d.density.scale;
+  CloudParams cp;
+  cp.octaves = d.density.octaves;
+  cp.frequency = d.density.frequency;
+  cp.amplitude = d.density.amplitude;
+  cp.seed = d.density.seed;
+  cp.edge = d.density.edge;
+  m.cloud = make_cloud_density(cp);
+  return m;
+}
+
+// An upper bound of the medium's density over the object's bounds, from interval arithmetic on
+// the object's function.
+double density_bound(const Medium& m, const SceneObject& obj) {
+  const Interval F = evaluate(obj.tape, obj.bounds);
+  switch (m.density) {
+    case Medium::Density::Constant:
+      return m.scale;
+    case Medium::Density::Field:
+      return m.scale * std::max(F.hi, 0.0);
+    case Medium::Density::Cloud:
+      return m.scale * cloud_density_range(F.lo, F.hi, m.cloud.params).second;
+  }
+  return 0.0;
+}
+
+}  // namespace
+
+Scene compile_scene(const SceneDesc& desc) {
+  Scene scene;
+  scene.settings.width = desc.film.width;
+  scene.settings.height = desc.film.height;
+  scene.settings.spp = desc.integrator.spp;
+  scene.settings.seed = desc.integrator.seed;
+  scene.settings.max_depth = desc.integrator.max_depth;
+  scene.camera = compile_camera(desc.camera, desc.film);
+
+  for (const MediumDesc& md : desc.media) scene.media.push_back(compile_medium(md));
+
+  Box all;
+  for (const ObjectDesc& od : desc.objects) {
+    SceneObject obj;
+    obj.tape = compile(*od.shape);
+    const Bounds b = compute_bounds(obj.tape);
+    if (!b.bounded)
+      throw SceneError(fmt::format(
+          "{}: {}/shape: shape \"{}\" is unbounded; clip it with an intersection (e.g. a box)",
+          desc.source, od.json_path, od.shape_name));
+    if (b.box.empty()) continue;  // nothing is inside: the object cannot be seen
+    obj.bounds = b.box;
+    obj.surface = compile_surface(od.surface);
+    // An opaque surface hides its medium; only solids and index-matched objects hold one.
+    obj.medium =
+        obj.surface.type == Surface::Type::Diffuse || obj.surface.type == Surface::Type::Emissive
+            ? -1
+            : od.medium;
+    if (obj.surface.type == Surface::Type::None) {
+      if (scene.field_objects.size() == MediumPoint::kMaxMedia)
+        throw SceneError(
+            fmt::format("{}: {}/medium: at most {} index-matched (surface none) "
+                        "medium objects are supported",
+                        desc.source, od.json_path, MediumPoint::kMaxMedia));
+      scene.field_objects.push_back(static_cast<int>(scene.objects.size()));
+    }
+    all = unite(all, obj.bounds);
+    scene.objects.push_back(std::move(obj));
+  }
+  for (const LightDesc& ld : desc.lights) scene.lights.push_back(compile_light(ld));
+  // Each medium's majorant is the largest bound over the objects that hold it.
+  for (Medium& m : scene.media) m.density_max = 0;
+  for (const SceneObject& obj : scene.objects)
+    if (obj.medium >= 0) {
+      Medium& m = scene.media[obj.medium];
+      m.density_max = std::max(m.density_max, density_bound(m, obj));
+    }
+  if (!all.empty()) scene.scale = length(all.extent());
+  return scene;
+}
+
+}  // namespace nimbus

@@ -1,0 +1,210 @@
+// The nimbus command line, run as a program: exit codes, one-line errors naming the JSON path,
+// no output left behind by a failed run, and the outputs of a good one.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int code;
+  std::string err;
+};
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("nimbus_cli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string write(const std::string& name, const std::string& text) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p.string();
+  }
+  Outcome run(const std::string& args) {
+    const std::string err_file = (dir_ / "stderr.txt").string();
+    const std::string cmd = "cd '" + dir_.string() + "' && '" + NIMBUS_BINARY + "' " + args +
+                            " >/dev/null 2>'" + err_file + "'";
+    const int status = std::system(cmd.c_str());
+    std::ifstream f(err_file);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    fs::remove(err_file);
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
+  }
+  // Everything left in the directory besides the scene files.
+  std::vector<std::string> outputs() const {
+    std::vector<std::string> out;
+    for (const auto& e : fs::directory_iterator(dir_))
+      if (e.path().extension() != ".json") out.push_back(e.path().filename().string());
+    return out;
+  }
+  fs::path dir_;
+};
+
+// A small valid scene; tests break one thing in it.
+nlohmann::json good_scene() {
+  return nlohmann::json::parse(R"({
+    "film": {"width": 16, "height": 12},
+    "camera": {"type": "perspective", "from": [0, 1, 6], "to": [0, 0, 0], "fov": 35},
+    "integrator": {"spp": 2, "seed": 1},
+    "lights": [{"type": "environment", "radiance": [0.8, 0.9, 1.0]},
+               {"type": "sphere", "center": [0, 5, 0], "radius": 0.5, "radiance": 20}],
+    "shapes": {
+      "ball": {"type": "sphere", "center": [0, 0, 0], "radius": 1},
+      "bump": {"type": "quadric", "coefficients": [-4, -4, -4, 0, 0, 0, 0, 0, 4, -0.75]},
+      "blob": {"type": "freeform", "base": "ball", "perturbations": [{"shape": "bump", "weight": 2.5}]},
+      "floor": {"type": "box", "min": [-5, -1.2, -5], "max": [5, -1, 5]}
+    },
+    "media": {"fog": {"sigma_a": 0.1, "sigma_s": [1, 2, 3]}},
+    "objects": [
+      {"shape": "blob", "surface": {"type": "diffuse", "albedo": [0.7, 0.5, 0.3]}},
+      {"shape": "floor", "surface": {"type": "diffuse", "albedo": 0.5}},
+      {"shape": {"type": "sphere", "center": [2, 0, 0], "radius": 0.5}, "medium": "fog"}
+    ]
+  })");
+}
+
+struct BadCase {
+  const char* name;
+  const char* pointer;  // JSON pointer to change ("" to replace the whole text)
+  const char* value;    // JSON value to put there, or raw text, or "DELETE"
+  const char* message;  // the expected stderr line after "scene.json: "
+};
+
+const BadCase kBad[] = {
+    {"syntax", "", "{\"film\": {\"width\": 16,}}", "parse error"},
+    {"no_camera", "/camera", "DELETE", "/camera: required key is missing"},
+    {"width_type", "/film/width", "\"wide\"", "/film/width: expected an integer"},
+    {"width_zero", "/film/width", "0", "/film/width: must be"},
+    {"unknown_key", "/camera/fvo", "30", "/camera/fvo: unknown key"},
+    {"unknown_camera", "/camera/type", "\"fisheye\"", "/camera/type:"},
+    {"fov_range", "/camera/fov", "180", "/camera/fov: must be"},
+    {"camera_degenerate", "/camera/to", "[0, 1, 6]", "/camera"},
+    {"spp_negative", "/integrator/spp", "-3", "/integrator/spp: must be"},
+    {"unknown_tracking", "/integrator/tracking", "\"magic\"", "/integrator/tracking:"},
+    {"unknown_shape", "/objects/1/shape", "\"blobb\"", "/objects/1/shape: unknown shape \"blobb\""},
+    {"unknown_primitive", "/shapes/ball/type", "\"torus\"", "/shapes/ball/type:"},
+    {"negative_radius", "/shapes/ball/radius", "-1", "/shapes/ball/radius: must be"},
+    {"cycle", "/shapes/ball", "{\"type\": \"freeform\", \"base\": \"blob\", \"perturbations\": []}",
+     "cycle in shape references"},
+    {"coefficients_short", "/shapes/bump/coefficients", "[1, 2, 3]", "/shapes/bump/coefficients:"},
+    {"degenerate_transform", "/shapes/blob/transform", "[{\"scale\": 0}]",
+     "/shapes/blob/transform/0"},
+    {"albedo_above_one", "/objects/0/surface/albedo", "1.5", "/objects/0/surface/albedo: must be"},
+    {"ior_below_one", "/objects/0/surface", "{\"type\": \"dielectric\", \"ior\": 0.8}",
+     "/objects/0/surface/ior: must be"},
+    {"negative_sigma", "/media/fog/sigma_s/1", "-2", "/media/fog/sigma_s/1: must be"},
+    {"unknown_medium", "/objects/2/medium", "\"smoke\"", "/objects/2/medium:"},
+    {"hg_range", "/media/fog/phase", "{\"type\": \"hg\", \"g\": 1.0}",
+     "/media/fog/phase/g: must be"},
+    {"light_type", "/lights/0/type", "\"area\"", "/lights/0/type:"},
+    {"zero_direction", "/lights/1",
+     "{\"type\": \"directional\", \"direction\": [0, 0, 0], \"irradiance\": 1}",
+     "/lights/1/direction:"},
+    {"unbounded", "/objects/1/shape",
+     "{\"type\": \"halfspace\", \"point\": [0, -1, 0], \"normal\": [0, -1, 0]}",
+     "/objects/1/shape: shape \"inline\" is unbounded"},
+};
+
+TEST_F(Cli, MalformedScenesExitTwoWithOneLineAndNoOutput) {
+  int checked = 0;
+  for (const BadCase& c : kBad) {
+    std::string text;
+    if (std::string(c.pointer).empty()) {
+      text = c.value;
+    } else {
+      nlohmann::json j = good_scene();
+      const nlohmann::json::json_pointer ptr(c.pointer);
+      if (std::string(c.value) == "DELETE")
+        j.at(ptr.parent_pointer()).erase(ptr.back());
+      else
+        j[ptr] = nlohmann::json::parse(c.value);
+      text = j.dump(2);
+    }
+    write("scene.json", text);
+    const Outcome r = run("render scene.json --quiet");
+    EXPECT_EQ(r.code, 2) << c.name << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.name << ": " << r.err;
+    EXPECT_EQ(r.err.rfind("scene.json: ", 0), 0u) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos)
+        << c.name << ": expected \"" << c.message << "\" in: " << r.err;
+    EXPECT_TRUE(outputs().empty()) << c.name << " left an output behind";
+    ++checked;
+  }
+  EXPECT_GE(checked, 20);
+}
+
+TEST_F(Cli, UsageErrorsExitTwo) {
+  write("scene.json", good_scene().dump());
+  EXPECT_EQ(run("").code, 2);
+  EXPECT_EQ(run("render").code, 2);
+  EXPECT_EQ(run("render scene.json --spp 0").code, 2);
+  EXPECT_EQ(run("render scene.json --bogus").code, 2);
+  const Outcome missing = run("render nowhere.json");
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_NE(missing.err.find("nowhere.json: cannot open file"), std::string::npos) << missing.err;
+  const Outcome bad_ext = run("render scene.json -o out.jpg");
+  EXPECT_EQ(bad_ext.code, 2);
+  EXPECT_NE(bad_ext.err.find("out.jpg: unknown image format"), std::string::npos) << bad_ext.err;
+  const Outcome bad_dir = run("render scene.json -o nodir/out.png");
+  EXPECT_EQ(bad_dir.code, 2);
+  const Outcome bad_set = run("render scene.json --set integrator.spp=abc");
+  EXPECT_EQ(bad_set.code, 2);
+  EXPECT_NE(bad_set.err.find("--set integrator.spp=abc"), std::string::npos) << bad_set.err;
+  EXPECT_TRUE(outputs().empty());
+  EXPECT_EQ(run("--version").code, 0);
+  EXPECT_EQ(run("--help").code, 0);
+}
+
+TEST_F(Cli, RendersDefaultOutputsAndStats) {
+  write("scene.json", good_scene().dump());
+  const Outcome r =
+      run("render scene.json --stats stats.json --set film.width=8 --spp 3 --threads 2");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "scene.exr"));
+  EXPECT_TRUE(fs::exists(dir_ / "scene.png"));
+  std::ifstream f(dir_ / "stats.json");
+  const nlohmann::json s = nlohmann::json::parse(f);
+  EXPECT_EQ(s["width"], 8);
+  EXPECT_EQ(s["spp"], 3);
+  EXPECT_EQ(s["threads"], 2);
+  EXPECT_EQ(s["counters"]["paths"], 8 * 12 * 3);
+  EXPECT_GT(s["samples_per_second"].get<double>(), 0);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_GT(s["image_mean"][c].get<double>(), 0);
+    EXPECT_GT(s["image_mean_standard_error"][c].get<double>(), 0);
+  }
+  EXPECT_GT(s["counters"]["density_lookups"].get<long>(), 0);
+}
+
+TEST_F(Cli, OutputIsTheSameForOneAndTwoThreads) {
+  write("scene.json", good_scene().dump());
+  ASSERT_EQ(run("render scene.json -o one.exr --threads 1 --quiet").code, 0);
+  ASSERT_EQ(run("render scene.json -o two.exr --threads 2 --quiet").code, 0);
+  auto bytes = [&](const char* name) {
+    std::ifstream f(dir_ / name, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  };
+  EXPECT_EQ(bytes("one.exr"), bytes("two.exr"));
+  EXPECT_EQ(run("render scene.json -q").err, "");
+}
+
+}  // namespace

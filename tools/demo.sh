@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Sets up (Debian packages), builds nimbus in Release and renders the default demo scene to
+# demo.exr and demo.png in the current directory.
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+bash "$root/tools/setup.sh"
+cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$root/build" -j"$(nproc)" --target nimbus
+"$root/build/nimbus" render "$root/scenes/demo.json" -o demo.exr -o demo.png "$@"
