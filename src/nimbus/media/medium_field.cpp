@@ -62,9 +62,14 @@ MediumPoint medium_at(const Scene& scene, const Vec3& x, int inside) {
 MajorantSegments majorant_segments(const Scene& scene, const Ray& ray, double t_min, double t_max,
                                    int inside) {
   MajorantSegments out;
+  const double scale = scene.settings.tracking.majorant_scale;
   if (inside >= 0) {
     const int mi = scene.objects[inside].medium;
-    if (mi >= 0) out.seg[out.count++] = {t_min, t_max, majorant_of(scene.media[mi])};
+    if (mi >= 0) {
+      const Medium& m = scene.media[mi];
+      out.seg[out.count++] = {t_min, t_max, majorant_of(m) * scale,
+                              (m.sigma_a + m.sigma_s) * m.density_min};
+    }
     return out;
   }
   // Each field object's bounds along the ray; the majorant of a stretch is the sum of those
@@ -95,7 +100,7 @@ MajorantSegments majorant_segments(const Scene& scene, const Ray& ray, double t_
         mu_bar += spans[s].mu_bar;
         covered = true;
       }
-    if (covered) out.seg[out.count++] = {a, b, mu_bar};
+    if (covered) out.seg[out.count++] = {a, b, mu_bar * scale};
   }
   return out;
 }

@@ -28,10 +28,12 @@ struct MediumPoint {
 // `inside` is the solid object the point is in (-1: none).
 MediumPoint medium_at(const Scene& scene, const Vec3& x, int inside);
 
-// A stretch of a ray with a majorant of mu_t that holds there, per channel.
+// A stretch of a ray with a majorant mu_bar and a minorant mu_c of mu_t there, per channel.
+// mu_bar is multiplied by the scene's majorant scale, so it need not bound when that is < 1.
 struct MajorantSegment {
   double t0, t1;
   Rgb mu_bar;
+  Rgb mu_c{0.0};
 };
 
 // Majorant segments covering the media along the ray in [t_min, t_max], in order, with gaps

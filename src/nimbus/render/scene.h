@@ -16,11 +16,28 @@
 
 namespace nimbus {
 
+// How free paths and transmittance are estimated in media (docs/scene-format.md, integrator).
+struct TrackingSettings {
+  enum class Mode { Delta, SpectralMax, SpectralHistory, SpectralMis };
+  enum class Absorption { Collide, Weight };
+  enum class Transmittance { Ratio, ResidualRatio };
+  enum class MajorantSource { Bound, Sample };
+  Mode mode = Mode::Delta;
+  Absorption absorption = Absorption::Weight;
+  bool decomposition = false;
+  Transmittance transmittance = Transmittance::Ratio;
+  MajorantSource majorant_source = MajorantSource::Bound;
+  int majorant_samples = 4096;
+  double majorant_scale = 1;  // multiplies every majorant; < 1 studies majorants that do not bound
+  int octree_depth = 0;
+};
+
 struct RenderSettings {
   int width = 640, height = 480;
   int spp = 16;
   uint64_t seed = 0;
   int max_depth = 1000;
+  TrackingSettings tracking;
 };
 
 struct SceneObject {
