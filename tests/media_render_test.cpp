@@ -53,7 +53,7 @@ TEST(MediaRender, FieldAbsorberTransmittanceMatchesClosedForm) {
   const Rgb sigma_a({0.5, 1.0, 2.0});
   const int size = 20;
   Scene scene;
-  scene.settings = {size, size, 256, 11, 100};
+  scene.settings = {size, size, 256, 11, 100, {}};
   const double view = 2.2;
   scene.camera = orthographic_camera({0, 0, 4}, {0, 0, 0}, {0, 1, 0}, view, size, size);
   scene.lights.push_back(environment(1.0));
@@ -119,7 +119,7 @@ void expect_white_furnace(Scene& scene) {
 
 Scene furnace_scene(Medium medium, Surface::Type surface, const ShapePtr& shape) {
   Scene scene;
-  scene.settings = {12, 12, 64, 5, 100000};
+  scene.settings = {12, 12, 64, 5, 100000, {}};
   scene.camera = perspective_camera({0, 0.3, 3.5}, {0, 0, 0}, {0, 1, 0}, 40, 12, 12);
   medium.sigma_a = Rgb(0.0);
   scene.media.push_back(medium);
@@ -162,7 +162,7 @@ void expect_chandrasekhar(double theta0_deg, double theta_deg, const Rgb& albedo
   const double R = 1000;
   const double mu0 = std::cos(theta0_deg * kPi / 180), mu = std::cos(theta_deg * kPi / 180);
   Scene scene;
-  scene.settings = {6, 6, 2048, 3, 100000};
+  scene.settings = {6, 6, 2048, 3, 100000, {}};
   const Vec3 view_dir{std::sin(theta_deg * kPi / 180), -mu, 0};
   scene.camera =
       orthographic_camera(Vec3{0, 0, 0} - view_dir * 5.0, {0, 0, 0}, {0, 0, 1}, 0.5, 6, 6);

@@ -15,7 +15,7 @@ namespace {
 
 Scene sphere_scene(const Surface& surface, int size, int spp) {
   Scene scene;
-  scene.settings = {size, size, spp, 7, 1000};
+  scene.settings = {size, size, spp, 7, 1000, {}};
   scene.camera = orthographic_camera({0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 2.5, size, size);
   SceneObject obj;
   obj.tape = compile(*make_shape(QuadricNode{sphere({0, 0, 0}, 1)}));
