@@ -18,7 +18,7 @@ TEST(EmissionRender, EmittingAbsorberMatchesClosedForm) {
   const double background = 0.5, view = 2.2;
   const int size = 16;
   Scene scene;
-  scene.settings = {size, size, 256, 13, 100, {}};
+  scene.settings = {size, size, 1024, 13, 100, {}};
   scene.camera = orthographic_camera({0, 0, 4}, {0, 0, 0}, {0, 1, 0}, view, size, size);
   scene.lights.push_back(test::environment(background));
   Medium fire;
