@@ -1,5 +1,6 @@
 #include "nimbus/frep/tape.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <variant>
@@ -72,9 +73,13 @@ class Compiler {
 };
 
 // FlatFreeForm: Quadric(r0) followed by pairs Quadric(r1), AddCubePos(r0 += w · r1).
+// QuadricCsg: no AddCubePos at all.
 TapeKind classify(const Tape& tape, std::vector<double>& weights) {
   const auto& code = tape.code;
   if (code.size() == 1) return TapeKind::SingleQuadric;
+  if (std::none_of(code.begin(), code.end(),
+                   [](const Instr& in) { return in.op == Op::AddCubePos; }))
+    return TapeKind::QuadricCsg;
   const size_t perturbations = (code.size() - 1) / 2;
   if (code.size() % 2 == 0 || perturbations > kMaxFlatPerturbations) return TapeKind::General;
   for (size_t i = 0; i < perturbations; ++i) {

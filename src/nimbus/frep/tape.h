@@ -40,6 +40,7 @@ struct Instr {
 enum class TapeKind : std::uint8_t {
   SingleQuadric,  // one quadric: analytic roots
   FlatFreeForm,   // quadric base + quadric perturbations: piecewise polynomial of degree <= 6
+  QuadricCsg,     // union / intersection / difference of quadrics: crossings at leaf roots
   General,        // anything else: interval subdivision along the ray
 };
 
