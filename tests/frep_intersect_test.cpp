@@ -223,6 +223,24 @@ TEST(FirstHit, UnboundedShapes) {
   EXPECT_NEAR(*first_hit(terrain, Ray{{50, 0, 10}, {0, 0, -1}}, 0, 1e30), 10, 1e-10);
 }
 
+TEST(FirstHit, RayInsideABoundaryPlaneTerminates) {
+  // F ≡ 0 along the ray, general path: no range can exclude 0, yet the search must end.
+  const ShapePtr far_away = make_shape(FreeFormNode{test::leaf(sphere({100, 0, 0}, 1)),
+                                                    {{test::leaf(sphere({100, 1, 0}, 1)), 1.0}}});
+  const ShapePtr slab_like = make_shape(
+      CsgNode{CsgOp::Intersection,
+              {test::leaf(halfspace({0, 0, 0}, {0, 0, 1})), test::leaf(sphere({0, 0, 0}, 2))}});
+  const Tape tape = compile(*make_shape(FreeFormNode{slab_like, {{far_away, 1.0}}}));
+  ASSERT_EQ(tape.kind, TapeKind::General);
+  const auto start = std::chrono::steady_clock::now();
+  const auto t = first_hit(tape, Ray{{-5, 0, 0}, {1, 0, 0}}, 0, 1e30);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 0.5);
+  if (t) {
+    EXPECT_GE(*t, 3 - 1e-9);
+    EXPECT_LE(*t, 7 + 1e-9);
+  }
+}
+
 TEST(FirstHit, EmptyShapeIsNeverHit) {
   const Tape tape = compile(*test::leaf(sphere({0, 0, 0}, 1), Mat4::identity()));
   const Tape empty = compile(*make_shape(CsgNode{

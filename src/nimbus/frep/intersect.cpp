@@ -188,36 +188,57 @@ std::optional<double> first_hit_quadric_csg(const Tape& tape, const Ray& ray, do
 // no crossing; one whose dF/dt excludes 0 is monotone, so it crosses iff its ends differ, and
 // Newton–bisection finds it; a piece narrower than 1e-12 of the shape counts only by its ends.
 std::optional<double> first_hit_general(const Tape& tape, const Ray& ray, double t_end) {
+  struct Leaf {
+    RayQuadratic q;
+    // A perturbation <= 0 over the whole segment (most of them miss a given ray) adds exactly 0
+    // on every piece, so its range over the whole segment serves for all of them, computed once.
+    // Only there: elsewhere a range that does not shrink with the piece would stall subdivision.
+    bool idle;
+    DualInterval whole;
+  };
   // Per-thread scratch, grown once: no allocation per ray.
-  thread_local std::vector<RayQuadratic> leaves;
+  thread_local std::vector<Leaf> leaves;
   leaves.resize(tape.quadrics.size());
-  for (size_t i = 0; i < leaves.size(); ++i) leaves[i] = restrict_to_ray(tape.quadrics[i], ray);
+  for (size_t i = 0; i < leaves.size(); ++i) {
+    Leaf& leaf = leaves[i];
+    leaf.q = restrict_to_ray(tape.quadrics[i], ray);
+    leaf.idle = false;
+    if (tape.only_cubed[i]) {
+      leaf.whole = quadratic_range(leaf.q, {0.0, t_end});
+      leaf.idle = leaf.whole.value.hi <= 0;
+    }
+  }
 
   const auto value_at = [&](double t) {
-    return run_tape<double>(tape, [&](std::uint32_t i) { return leaves[i].at(t); });
+    return run_tape<double>(tape, [&](std::uint32_t i) { return leaves[i].q.at(t); });
   };
   const auto dual_at = [&](double t) {
     return run_tape<Dual>(tape, [&](std::uint32_t i) {
-      return Dual{leaves[i].at(t), leaves[i].derivative(t)};
+      return Dual{leaves[i].q.at(t), leaves[i].q.derivative(t)};
     });
   };
   const auto range_over = [&](Interval t) {
-    return run_tape<DualInterval>(tape,
-                                  [&](std::uint32_t i) { return quadratic_range(leaves[i], t); });
+    return run_tape<DualInterval>(tape, [&](std::uint32_t i) {
+      const Leaf& leaf = leaves[i];
+      return leaf.idle ? leaf.whole : quadratic_range(leaf.q, t);
+    });
   };
 
   const double min_width = 1e-12 * tape.size / length(ray.d);
   constexpr int kStack = 160;
+  // Where F vanishes identically along the ray (a ray in a boundary plane) no range ever
+  // excludes 0; past this many pieces, every piece is decided by its ends alone.
+  constexpr int kMaxPieces = 4096;
   Interval stack[kStack];
-  int top = 0;
+  int top = 0, pieces = 0;
   stack[top++] = {0.0, t_end};
   while (top > 0) {
     const Interval piece = stack[--top];
     const DualInterval f = range_over(piece);
     if (f.value.excludes_zero()) continue;
     const double mid = 0.5 * (piece.lo + piece.hi);
-    const bool narrow =
-        piece.hi - piece.lo <= min_width || !(mid > piece.lo && mid < piece.hi) || top + 2 > kStack;
+    const bool narrow = piece.hi - piece.lo <= min_width || !(mid > piece.lo && mid < piece.hi) ||
+                        top + 2 > kStack || ++pieces > kMaxPieces;
     if (narrow || f.slope.excludes_zero()) {
       const bool inside_lo = value_at(piece.lo) > 0;
       if (inside_lo != (value_at(piece.hi) > 0))

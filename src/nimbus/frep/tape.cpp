@@ -107,6 +107,13 @@ Box search_box(const Bounds& bounds) {
 Tape compile(const ShapeDesc& shape) {
   Tape tape;
   Compiler(tape).emit(shape, Mat4::identity(), 0);
+  tape.only_cubed.assign(tape.quadrics.size(), 0);
+  for (size_t k = 0; k + 1 < tape.code.size(); ++k) {
+    const Instr &load = tape.code[k], &next = tape.code[k + 1];
+    // The emitter consumes a perturbation's register right away and never reads it again.
+    if (load.op == Op::Quadric && next.op == Op::AddCubePos && next.src == load.dst)
+      tape.only_cubed[load.quadric] = 1;
+  }
   tape.kind = classify(tape, tape.weights);
   if (tape.kind != TapeKind::FlatFreeForm) tape.weights.clear();
   tape.bounds = compute_bounds(tape);
