@@ -161,6 +161,7 @@ std::optional<double> first_hit_quadric_csg(const Tape& tape, const Ray& ray, do
   thread_local std::vector<Event> events;
   sign.resize(tape.quadrics.size());
   events.clear();
+  events.reserve(2 * tape.quadrics.size());
   for (std::uint32_t i = 0; i < sign.size(); ++i) {
     const RayQuadratic q = restrict_to_ray(tape.quadrics[i], ray);
     // The sign just after t = 0 (from the next nonzero derivative when q(0) is exactly 0).
