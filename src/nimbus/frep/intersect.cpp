@@ -106,18 +106,26 @@ std::optional<double> first_hit_flat(const Tape& tape, const Ray& ray, double t_
     const double u0 = breaks[k], u1 = breaks[k + 1];
     if (!(u1 > u0)) continue;
     const double mid = 0.5 * (u0 + u1);
-    // Most pieces are far from the surface: a conservative range of F over the piece rejects
-    // them for a fraction of the root isolation's cost.
+    // Most pieces are far from the surface: conservative ranges of F and dF/dt over the piece
+    // reject them, or show F monotone there, for a fraction of the root isolation's cost.
     const Interval piece{u0, u1};
-    Interval range = quadratic_range(base, piece).value;
+    DualInterval range = quadratic_range(base, piece);
     for (const Bump& bump : active_bumps)
       if (bump.at(mid) > 0)
-        range = range +
-                bump.weight * positive_cube(quadratic_range({bump.a, bump.b, bump.c}, piece).value);
-    if (range.excludes_zero()) {
-      const bool inside = range.lo > 0;
+        range =
+            range + bump.weight * positive_cube(quadratic_range({bump.a, bump.b, bump.c}, piece));
+    if (range.value.excludes_zero()) {
+      const bool inside = range.value.lo > 0;
       if (k > 0 && inside != inside_before) return u0;
       inside_before = inside;
+      continue;
+    }
+    const auto f = [&](double t) { return flat_free_form_at(base, active_bumps, t); };
+    if (range.slope.excludes_zero()) {
+      const bool inside0 = f(u0).value > 0, inside1 = f(u1).value > 0;
+      if (k > 0 && inside0 != inside_before) return u0;
+      if (inside0 != inside1) return newton_bisection(f, u0, u1, inside0);
+      inside_before = inside1;
       continue;
     }
     double c[7] = {base.at(u0), base.derivative(u0), base.a, 0, 0, 0, 0};
