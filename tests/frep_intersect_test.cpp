@@ -160,24 +160,29 @@ TEST(FirstHit, AgreesWithBruteForceOnTheGallery) {
   }
 }
 
-// The flat free-form path and the general interval path find the same roots.
-TEST(FirstHit, FlatAndGeneralPathsAgree) {
+// The fast paths (flat free form, CSG of quadrics) and the general interval path find the same
+// roots. A far-away nested perturbation changes nothing near the shape but forces the general
+// path.
+TEST(FirstHit, FastPathsAgreeWithTheGeneralPath) {
   Rng rng(11);
-  for (int count : {1, 8, 32}) {
-    const ShapePtr flat_shape = test::bumpy_sphere(rng, count);
-    // Cutting by a huge sphere changes nothing inside but forces the general path.
-    const ShapePtr general_shape =
-        make_shape(CsgNode{CsgOp::Intersection, {flat_shape, test::leaf(sphere({0, 0, 0}, 100))}});
-    const Tape flat = compile(*flat_shape), general = compile(*general_shape);
-    ASSERT_EQ(flat.kind, TapeKind::FlatFreeForm);
-    ASSERT_EQ(general.kind, TapeKind::General);
-    const GalleryShape g{"bumpy", flat_shape, {0, 0, 0}, 1.9};
+  std::vector<GalleryShape> shapes;
+  for (int count : {1, 8, 32})
+    shapes.push_back({"bumpy", test::bumpy_sphere(rng, count), {0, 0, 0}, 1.9});
+  for (const auto& g : test::gallery())
+    if (compile(*g.shape).kind == TapeKind::QuadricCsg) shapes.push_back(g);
+  for (const auto& g : shapes) {
+    const ShapePtr far_away = make_shape(FreeFormNode{test::leaf(sphere({100, 0, 0}, 1)),
+                                                      {{test::leaf(sphere({100, 1, 0}, 1)), 1.0}}});
+    const ShapePtr general_shape = make_shape(FreeFormNode{g.shape, {{far_away, 1.0}}});
+    const Tape fast = compile(*g.shape), general = compile(*general_shape);
+    ASSERT_NE(fast.kind, TapeKind::General) << g.name;
+    ASSERT_EQ(general.kind, TapeKind::General) << g.name;
     for (int i = 0; i < 2000; ++i) {
-      const Ray ray = random_ray(flat, g, rng, i % 10);
-      const auto a = first_hit(flat, ray, 0, 1e30), b = first_hit(general, ray, 0, 1e30);
-      ASSERT_EQ(a.has_value(), b.has_value()) << count << " ray " << i;
+      const Ray ray = random_ray(fast, g, rng, i % 10);
+      const auto a = first_hit(fast, ray, 0, 1e30), b = first_hit(general, ray, 0, 1e30);
+      ASSERT_EQ(a.has_value(), b.has_value()) << g.name << " ray " << i;
       if (a) {
-        ASSERT_NEAR(*a, *b, 1e-9 * 3.8 / length(ray.d)) << count << " ray " << i;
+        ASSERT_NEAR(*a, *b, 1e-9 * 2 * g.radius / length(ray.d)) << g.name << " ray " << i;
       }
     }
   }
@@ -216,6 +221,24 @@ TEST(FirstHit, UnboundedShapes) {
   }
   EXPECT_NEAR(*first_hit(terrain, Ray{{0, 0, 10}, {0, 0, -1}}, 0, 1e30), 10 - lo, 1e-10);
   EXPECT_NEAR(*first_hit(terrain, Ray{{50, 0, 10}, {0, 0, -1}}, 0, 1e30), 10, 1e-10);
+}
+
+TEST(FirstHit, RayInsideABoundaryPlaneTerminates) {
+  // F ≡ 0 along the ray, general path: no range can exclude 0, yet the search must end.
+  const ShapePtr far_away = make_shape(FreeFormNode{test::leaf(sphere({100, 0, 0}, 1)),
+                                                    {{test::leaf(sphere({100, 1, 0}, 1)), 1.0}}});
+  const ShapePtr slab_like = make_shape(
+      CsgNode{CsgOp::Intersection,
+              {test::leaf(halfspace({0, 0, 0}, {0, 0, 1})), test::leaf(sphere({0, 0, 0}, 2))}});
+  const Tape tape = compile(*make_shape(FreeFormNode{slab_like, {{far_away, 1.0}}}));
+  ASSERT_EQ(tape.kind, TapeKind::General);
+  const auto start = std::chrono::steady_clock::now();
+  const auto t = first_hit(tape, Ray{{-5, 0, 0}, {1, 0, 0}}, 0, 1e30);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 0.5);
+  if (t) {
+    EXPECT_GE(*t, 3 - 1e-9);
+    EXPECT_LE(*t, 7 + 1e-9);
+  }
 }
 
 TEST(FirstHit, EmptyShapeIsNeverHit) {

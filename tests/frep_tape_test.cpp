@@ -35,8 +35,10 @@ TEST(Tape, ClassifiesShapes) {
             TapeKind::FlatFreeForm);
   for (const auto& g : gallery()) {
     const Tape tape = compile(*g.shape);
-    if (g.name == "nested_free_form" || g.name.starts_with("csg") || g.name == "box" ||
-        g.name == "clipped_cylinder") {
+    if (g.name == "clipped_cylinder" || g.name == "csg_difference" || g.name == "box") {
+      EXPECT_EQ(tape.kind, TapeKind::QuadricCsg) << g.name;
+    }
+    if (g.name == "nested_free_form" || g.name == "csg_union") {
       EXPECT_EQ(tape.kind, TapeKind::General) << g.name;
     }
     EXPECT_LE(tape.num_registers, kMaxRegisters);

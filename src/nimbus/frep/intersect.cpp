@@ -18,9 +18,12 @@ namespace {
 // the cancellation-free pair q / a, c / q with q = −(b + sign(b) √disc) / 2; when a → 0 the root
 // q / a runs off to ±∞ and c / q tends to the linear root −c / b, so a ≈ 0 needs no special case.
 int sign_change_roots(const RayQuadratic& p, double roots[2]) {
-  // disc = b² − 4ac with the product's rounding error recovered by fma (Kahan).
   const double four_ac = 4 * p.a * p.c;
-  const double disc = std::fma(p.b, p.b, -four_ac) + std::fma(-4 * p.a, p.c, four_ac);
+  double disc = p.b * p.b - four_ac;
+  // Near a double root b² and 4ac cancel: recover the products' rounding errors by fma (Kahan).
+  // Only then, since without -mfma every fma is a libm call.
+  if (std::abs(disc) < 1e-6 * p.b * p.b)
+    disc = std::fma(p.b, p.b, -four_ac) + std::fma(-4 * p.a, p.c, four_ac);
   if (!(disc > 0)) return 0;
   const double q = -0.5 * (p.b + std::copysign(std::sqrt(disc), p.b));
   double r0 = q / p.a, r1 = p.c / q;
@@ -103,6 +106,28 @@ std::optional<double> first_hit_flat(const Tape& tape, const Ray& ray, double t_
     const double u0 = breaks[k], u1 = breaks[k + 1];
     if (!(u1 > u0)) continue;
     const double mid = 0.5 * (u0 + u1);
+    // Most pieces are far from the surface: conservative ranges of F and dF/dt over the piece
+    // reject them, or show F monotone there, for a fraction of the root isolation's cost.
+    const Interval piece{u0, u1};
+    DualInterval range = quadratic_range(base, piece);
+    for (const Bump& bump : active_bumps)
+      if (bump.at(mid) > 0)
+        range =
+            range + bump.weight * positive_cube(quadratic_range({bump.a, bump.b, bump.c}, piece));
+    if (range.value.excludes_zero()) {
+      const bool inside = range.value.lo > 0;
+      if (k > 0 && inside != inside_before) return u0;
+      inside_before = inside;
+      continue;
+    }
+    const auto f = [&](double t) { return flat_free_form_at(base, active_bumps, t); };
+    if (range.slope.excludes_zero()) {
+      const bool inside0 = f(u0).value > 0, inside1 = f(u1).value > 0;
+      if (k > 0 && inside0 != inside_before) return u0;
+      if (inside0 != inside1) return newton_bisection(f, u0, u1, inside0);
+      inside_before = inside1;
+      continue;
+    }
     double c[7] = {base.at(u0), base.derivative(u0), base.a, 0, 0, 0, 0};
     int degree = 2;
     for (const Bump& bump : active_bumps)
@@ -131,39 +156,98 @@ std::optional<double> first_hit_flat(const Tape& tape, const Ray& ray, double t_
   return std::nullopt;
 }
 
+// CSG of quadrics: max, min and negation preserve "F > 0" as a boolean function of the leaves'
+// "q_i > 0", so F can change sign only where some leaf does, at one of the leaves' roots. Walk the
+// roots in order, flipping that leaf's sign, and evaluate the boolean with ±1 for the leaves;
+// the signs come from the root structure, not from evaluating q_i near its own root.
+std::optional<double> first_hit_quadric_csg(const Tape& tape, const Ray& ray, double t_end) {
+  struct Event {
+    double t;
+    std::uint32_t leaf;
+  };
+  thread_local std::vector<double> sign;
+  thread_local std::vector<Event> events;
+  sign.resize(tape.quadrics.size());
+  events.clear();
+  events.reserve(2 * tape.quadrics.size());
+  for (std::uint32_t i = 0; i < sign.size(); ++i) {
+    const RayQuadratic q = restrict_to_ray(tape.quadrics[i], ray);
+    // The sign just after t = 0 (from the next nonzero derivative when q(0) is exactly 0).
+    const bool positive = q.c > 0 || (q.c == 0 && (q.b > 0 || (q.b == 0 && q.a > 0)));
+    sign[i] = positive ? 1.0 : -1.0;
+    double roots[2];
+    const int count = sign_change_roots(q, roots);
+    for (int r = 0; r < count; ++r)
+      if (roots[r] > 0 && roots[r] <= t_end) events.push_back({roots[r], i});
+  }
+  std::sort(events.begin(), events.end(), [](const Event& x, const Event& y) { return x.t < y.t; });
+  const auto inside = [&] {
+    return run_tape<double>(tape, [&](std::uint32_t i) { return sign[i]; }) > 0;
+  };
+  const bool inside_start = inside();
+  for (size_t k = 0; k < events.size();) {
+    const double t = events[k].t;
+    for (; k < events.size() && events[k].t == t; ++k) sign[events[k].leaf] *= -1;
+    if (inside() != inside_start) return t;
+  }
+  return std::nullopt;
+}
+
 // Anything else: subdivide [0, t_end] front to back. A piece whose range of F excludes 0 holds
 // no crossing; one whose dF/dt excludes 0 is monotone, so it crosses iff its ends differ, and
 // Newton–bisection finds it; a piece narrower than 1e-12 of the shape counts only by its ends.
 std::optional<double> first_hit_general(const Tape& tape, const Ray& ray, double t_end) {
-  thread_local std::vector<RayQuadratic> leaves;
+  struct Leaf {
+    RayQuadratic q;
+    // A perturbation <= 0 over the whole segment (most of them miss a given ray) adds exactly 0
+    // on every piece, so its range over the whole segment serves for all of them, computed once.
+    // Only there: elsewhere a range that does not shrink with the piece would stall subdivision.
+    bool idle;
+    DualInterval whole;
+  };
+  // Per-thread scratch, grown once: no allocation per ray.
+  thread_local std::vector<Leaf> leaves;
   leaves.resize(tape.quadrics.size());
-  for (size_t i = 0; i < leaves.size(); ++i) leaves[i] = restrict_to_ray(tape.quadrics[i], ray);
+  for (size_t i = 0; i < leaves.size(); ++i) {
+    Leaf& leaf = leaves[i];
+    leaf.q = restrict_to_ray(tape.quadrics[i], ray);
+    leaf.idle = false;
+    if (tape.only_cubed[i]) {
+      leaf.whole = quadratic_range(leaf.q, {0.0, t_end});
+      leaf.idle = leaf.whole.value.hi <= 0;
+    }
+  }
 
   const auto value_at = [&](double t) {
-    return run_tape<double>(tape, [&](std::uint32_t i) { return leaves[i].at(t); });
+    return run_tape<double>(tape, [&](std::uint32_t i) { return leaves[i].q.at(t); });
   };
   const auto dual_at = [&](double t) {
     return run_tape<Dual>(tape, [&](std::uint32_t i) {
-      return Dual{leaves[i].at(t), leaves[i].derivative(t)};
+      return Dual{leaves[i].q.at(t), leaves[i].q.derivative(t)};
     });
   };
   const auto range_over = [&](Interval t) {
-    return run_tape<DualInterval>(tape,
-                                  [&](std::uint32_t i) { return quadratic_range(leaves[i], t); });
+    return run_tape<DualInterval>(tape, [&](std::uint32_t i) {
+      const Leaf& leaf = leaves[i];
+      return leaf.idle ? leaf.whole : quadratic_range(leaf.q, t);
+    });
   };
 
   const double min_width = 1e-12 * tape.size / length(ray.d);
   constexpr int kStack = 160;
+  // Where F vanishes identically along the ray (a ray in a boundary plane) no range ever
+  // excludes 0; past this many pieces, every piece is decided by its ends alone.
+  constexpr int kMaxPieces = 4096;
   Interval stack[kStack];
-  int top = 0;
+  int top = 0, pieces = 0;
   stack[top++] = {0.0, t_end};
   while (top > 0) {
     const Interval piece = stack[--top];
     const DualInterval f = range_over(piece);
     if (f.value.excludes_zero()) continue;
     const double mid = 0.5 * (piece.lo + piece.hi);
-    const bool narrow =
-        piece.hi - piece.lo <= min_width || !(mid > piece.lo && mid < piece.hi) || top + 2 > kStack;
+    const bool narrow = piece.hi - piece.lo <= min_width || !(mid > piece.lo && mid < piece.hi) ||
+                        top + 2 > kStack || ++pieces > kMaxPieces;
     if (narrow || f.slope.excludes_zero()) {
       const bool inside_lo = value_at(piece.lo) > 0;
       if (inside_lo != (value_at(piece.hi) > 0))
@@ -195,6 +279,9 @@ std::optional<double> first_hit(const Tape& tape, const Ray& ray, double t_min, 
       break;
     case TapeKind::FlatFreeForm:
       s = first_hit_flat(tape, local, hi);
+      break;
+    case TapeKind::QuadricCsg:
+      s = first_hit_quadric_csg(tape, local, hi);
       break;
     case TapeKind::General:
       s = first_hit_general(tape, local, hi);

@@ -1,5 +1,6 @@
 #include "nimbus/frep/tape.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <variant>
@@ -72,18 +73,34 @@ class Compiler {
 };
 
 // FlatFreeForm: Quadric(r0) followed by pairs Quadric(r1), AddCubePos(r0 += w · r1).
-TapeKind classify(const Tape& tape, std::vector<double>& weights) {
-  const auto& code = tape.code;
+// QuadricCsg: no AddCubePos at all.
+TapeKind classify(const std::vector<Instr>& code) {
   if (code.size() == 1) return TapeKind::SingleQuadric;
+  if (std::none_of(code.begin(), code.end(),
+                   [](const Instr& in) { return in.op == Op::AddCubePos; }))
+    return TapeKind::QuadricCsg;
   const size_t perturbations = (code.size() - 1) / 2;
   if (code.size() % 2 == 0 || perturbations > kMaxFlatPerturbations) return TapeKind::General;
   for (size_t i = 0; i < perturbations; ++i) {
     const Instr& load = code[1 + 2 * i];
     const Instr& add = code[2 + 2 * i];
-    if (load.op != Op::Quadric || add.op != Op::AddCubePos) return TapeKind::General;
-    weights.push_back(add.weight);
+    if (load.op != Op::Quadric || load.dst != 1 || add.op != Op::AddCubePos || add.dst != 0 ||
+        add.src != 1)
+      return TapeKind::General;
   }
   return TapeKind::FlatFreeForm;
+}
+
+// Marks the quadrics whose value is only ever cubed: the emitter consumes a perturbation's
+// register right after loading it and never reads it again.
+std::vector<std::uint8_t> only_cubed(const Tape& tape) {
+  std::vector<std::uint8_t> marks(tape.quadrics.size(), 0);
+  for (size_t k = 0; k + 1 < tape.code.size(); ++k) {
+    const Instr &load = tape.code[k], &next = tape.code[k + 1];
+    if (load.op == Op::Quadric && next.op == Op::AddCubePos && next.src == load.dst)
+      marks[load.quadric] = 1;
+  }
+  return marks;
 }
 
 // The box first_hit clips rays to: the bounds grown by a relative 1e-9 so that rounding in the
@@ -102,8 +119,10 @@ Box search_box(const Bounds& bounds) {
 Tape compile(const ShapeDesc& shape) {
   Tape tape;
   Compiler(tape).emit(shape, Mat4::identity(), 0);
-  tape.kind = classify(tape, tape.weights);
-  if (tape.kind != TapeKind::FlatFreeForm) tape.weights.clear();
+  tape.only_cubed = only_cubed(tape);
+  tape.kind = classify(tape.code);
+  if (tape.kind == TapeKind::FlatFreeForm)
+    for (size_t k = 2; k < tape.code.size(); k += 2) tape.weights.push_back(tape.code[k].weight);
   tape.bounds = compute_bounds(tape);
   tape.search_box = search_box(tape.bounds);
   const double diagonal = length(tape.search_box.extent());

@@ -40,6 +40,7 @@ struct Instr {
 enum class TapeKind : std::uint8_t {
   SingleQuadric,  // one quadric: analytic roots
   FlatFreeForm,   // quadric base + quadric perturbations: piecewise polynomial of degree <= 6
+  QuadricCsg,     // union / intersection / difference of quadrics: crossings at leaf roots
   General,        // anything else: interval subdivision along the ray
 };
 
@@ -50,6 +51,9 @@ struct Tape {
   TapeKind kind = TapeKind::General;
   // FlatFreeForm only: quadrics[0] is the base, quadrics[i + 1] has weight weights[i].
   std::vector<double> weights;
+  // Per quadric: 1 when its value is used only as a perturbation max(q, 0)³, so that where
+  // q <= 0 nothing else about it matters.
+  std::vector<std::uint8_t> only_cubed;
   Bounds bounds;
   // Where first_hit looks: the bounds padded against round-off, or, for an unbounded shape,
   // its box cut to |x_i| <= kUnboundedExtent (the scene loader clips those anyway).

@@ -18,6 +18,9 @@ inline double positive_cube(double x) {
   const double p = x > 0 ? x : 0.0;
   return p * p * p;
 }
+inline bool nonpositive(double x) {
+  return x <= 0;
+}
 
 template <class T, class Leaf>
 T run_tape(const Tape& tape, const Leaf& leaf) {
@@ -39,7 +42,8 @@ T run_tape(const Tape& tape, const Leaf& leaf) {
         r[in.dst] = -r[in.dst];
         break;
       case Op::AddCubePos:
-        r[in.dst] = r[in.dst] + in.weight * positive_cube(r[in.src]);
+        // A perturbation that is nowhere positive adds exactly nothing (eq. 2); most are.
+        if (!nonpositive(r[in.src])) r[in.dst] = r[in.dst] + in.weight * positive_cube(r[in.src]);
         break;
     }
   }

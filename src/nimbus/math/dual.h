@@ -43,6 +43,17 @@ inline Dual positive_cube(Dual a) {
   return {p * p * p, 3 * p * p * a.slope};
 }
 
+// True when max(f, 0)³ and its derivative are exactly 0.
+inline bool nonpositive(Dual a) {
+  return a.value <= 0;
+}
+inline bool nonpositive(DualInterval a) {
+  return a.value.hi <= 0;
+}
+inline bool nonpositive(const DualGrad& a) {
+  return a.value <= 0;
+}
+
 inline DualInterval operator+(DualInterval a, DualInterval b) {
   return {a.value + b.value, a.slope + b.slope};
 }

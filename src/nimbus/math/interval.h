@@ -75,6 +75,11 @@ inline Interval positive_cube(Interval a) {
   return {a.lo > 0 ? cube_down(a.lo) : 0.0, a.hi > 0 ? cube_up(a.hi) : 0.0};
 }
 
+// True when max(x, 0)³ is exactly 0 over the whole interval.
+inline bool nonpositive(Interval a) {
+  return a.hi <= 0;
+}
+
 inline Interval max(Interval a, Interval b) {
   return {std::max(a.lo, b.lo), std::max(a.hi, b.hi)};
 }
