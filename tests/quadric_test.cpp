@@ -1,8 +1,9 @@
-#include "nimbus/frep/primitives.h"
 #include "nimbus/frep/quadric.h"
 
 #include <gtest/gtest.h>
 
+#include "nimbus/frep/primitives.h"
+#include "nimbus/math/box.h"
 #include "nimbus/math/rng.h"
 
 namespace nimbus {
@@ -100,6 +101,21 @@ TEST(Primitives, SurfacesPassThroughParameterPoints) {
   EXPECT_NEAR(sl.eval(c + Vec3{3, 1, 0.2}), 0, eps);
   EXPECT_NEAR(sl.eval(c + Vec3{-1, 0, -0.2}), 0, eps);
   EXPECT_GT(sl.eval(c), 0);
+}
+
+}  // namespace
+}  // namespace nimbus
+
+namespace nimbus {
+namespace {
+
+TEST(Box, ClipRayMissesAnEmptyBox) {
+  double t0 = 0, t1 = 10;
+  EXPECT_FALSE(clip_ray(Box{}, Ray{{0, 0, 0}, {1, 0, 0}}, t0, t1));
+  t0 = 0, t1 = 10;
+  EXPECT_TRUE(clip_ray(Box{{-1, -1, -1}, {1, 1, 1}}, Ray{{-5, 0, 0}, {1, 0, 0}}, t0, t1));
+  EXPECT_DOUBLE_EQ(t0, 4);
+  EXPECT_DOUBLE_EQ(t1, 6);
 }
 
 }  // namespace

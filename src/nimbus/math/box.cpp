@@ -12,6 +12,7 @@ bool Box::finite() const {
 }
 
 bool clip_ray(const Box& box, const Ray& ray, double& t0, double& t1) {
+  if (box.empty()) return false;
   for (int i = 0; i < 3; ++i) {
     const double inv = 1.0 / ray.d[i];
     double ta = (box.lo[i] - ray.o[i]) * inv;
