@@ -17,8 +17,8 @@ def main(out):
         rows = list(csv.DictReader(f))
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     trackings = list(dict.fromkeys(r["tracking"] for r in rows))
-    metrics = [("segments_relative_to_delta", "path segments / delta"),
-               ("lookups_relative_to_delta", "density lookups / delta"),
+    metrics = [("segments_relative_to_delta", "path segments (= lookups) per sample / delta"),
+               ("segments_per_scatter_relative_to_delta", "path segments per scattering event / delta"),
                ("efficiency_relative_to_delta", "equal-time efficiency / delta\n(delta MSE x s / MSE x s)")]
     fig, axes = plt.subplots(1, len(metrics), figsize=(12, 3.6))
     width = 0.8 / len(trackings)

@@ -12,7 +12,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-COLOURS = {"r": "tab:red", "g": "tab:green", "b": "tab:blue", "avg": "black"}
+COLOURS = {"r": "tab:red", "g": "tab:green", "b": "tab:blue"}
 TITLES = {"max": "max rule (eq. 6-9, Fig. 4)", "history": "history-aware average (eq. 10-13, Fig. 5)"}
 
 
@@ -22,31 +22,36 @@ def main(out):
         for r in csv.DictReader(f):
             rows[(r["medium"], r["rule"], r["channel"])].append(r)
     for medium in sorted({k[0] for k in rows}):
-        fig, axes = plt.subplots(1, 2, figsize=(10, 4), sharey=True)
-        for ax, rule in zip(axes, ["max", "history"]):
-            for ch, colour in COLOURS.items():
-                data = rows.get((medium, rule, ch))
-                if not data:
-                    continue
+        fig, axes = plt.subplots(3, 2, figsize=(10, 8), sharex=True, sharey=True)
+        for col, rule in enumerate(["max", "history"]):
+            for row, ch in enumerate(["r", "g", "b"]):
+                ax = axes[row][col]
+                colour = COLOURS[ch]
+                data = rows[(medium, rule, ch)]
                 d = [float(r["distance"]) for r in data]
-                mean = [float(r["mean"]) for r in data]
-                lo = [float(r["q05"]) for r in data]
-                hi = [float(r["q95"]) for r in data]
-                sd = [float(r["std"]) for r in data]
-                label = "channel average" if ch == "avg" else ch.upper()
-                ax.plot(d, mean, color=colour, label=f"{label} mean")
-                if ch != "avg":
-                    ax.plot(d, [m + s for m, s in zip(mean, sd)], color=colour, ls=":", lw=1)
-                    ax.fill_between(d, lo, hi, color=colour, alpha=0.12)
-            ax.set_title(TITLES[rule])
-            ax.set_xlabel("distance travelled")
-            ax.set_yscale("symlog", linthresh=1)
-            ax.grid(alpha=0.3)
-        axes[0].set_ylabel("path throughput (mean; dotted mean+std; band 5-95 %)")
-        axes[1].legend(fontsize=8)
-        fig.suptitle(f"Spectral tracking throughput, {medium} medium, albedo 1, sigma_s = (1, 5, 10)")
+                ax.fill_between(d, [float(r["q05"]) for r in data],
+                                [float(r["q95"]) for r in data], color=colour, alpha=0.15,
+                                label="5-95 %")
+                ax.plot(d, [float(r["mean"]) for r in data], color=colour, label="mean")
+                ax.plot(d, [float(r["q50"]) for r in data], color=colour, ls="--", label="median")
+                ax.plot(d, [float(r["max"]) for r in data], color=colour, ls=":", label="largest")
+                avg = rows[(medium, rule, "avg")]
+                ax.plot(d, [float(r["mean"]) for r in avg], color="black", lw=0.8,
+                        label="mean of channel average")
+                ax.set_yscale("log")
+                ax.set_ylim(1e-4, 1e4)
+                ax.grid(alpha=0.3)
+                if row == 0:
+                    ax.set_title(TITLES[rule])
+                if col == 0:
+                    ax.set_ylabel(f"{ch.upper()} throughput")
+                if row == 2:
+                    ax.set_xlabel("distance travelled")
+        axes[0][1].legend(fontsize=7, loc="upper left")
+        fig.suptitle(f"Spectral tracking throughput, {medium} medium, albedo 1, "
+                     "sigma_s = (1, 5, 10) (zeros not shown)")
         fig.tight_layout()
-        fig.savefig(f"{out}/throughput_{medium}.png", dpi=80)
+        fig.savefig(f"{out}/throughput_{medium}.png", dpi=72)
         plt.close(fig)
 
 

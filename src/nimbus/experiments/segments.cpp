@@ -47,8 +47,8 @@ double variance_estimate(const Film& f) {
 }  // namespace
 
 ExperimentReport run_segments(const ExperimentOptions& options) {
-  const Size size = options.quick ? Size{24, 16, 2} : Size{120, 80, 16};
-  const int reference_spp = options.quick ? 16 : 256;
+  const Size size = options.quick ? Size{24, 16, 2} : Size{96, 64, 16};
+  const int reference_spp = options.quick ? 16 : 128;
   const std::array<const char*, 2> scenes = {"cloud", "translucent"};
   const std::array<const char*, 3> trackings = {"delta", "spectral-max", "spectral-history"};
 
