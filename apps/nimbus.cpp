@@ -1,15 +1,19 @@
-// The nimbus command line: `nimbus render SCENE ...`.
+// The nimbus command line: `nimbus render SCENE ...` and `nimbus experiment NAME --out DIR`.
 
 #include <fmt/format.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
 
+#include "nimbus/experiments/experiment.h"
 #include "nimbus/io/atomic_file.h"
 #include "nimbus/io/output.h"
 #include "nimbus/render/renderer.h"
@@ -114,6 +118,84 @@ int run_render(const RenderArgs& args) {
   return 0;
 }
 
+struct ExperimentArgs {
+  std::string name;
+  std::string out;
+  std::string scenes = std::string(NIMBUS_SOURCE_DIR) + "/scenes";
+  bool quick = false;
+  bool no_plot = false;
+  long long seed = 0;
+  int threads = 0;
+};
+
+// The interpreter the plotting scripts name in their first line.
+constexpr const char* kPlotPython = "/usr/bin/python3";
+
+// Runs tools/plot_<name>.py on the experiment's directory, if there is such a script and
+// matplotlib can be imported; otherwise says why there is no plot. Never fails the experiment.
+void plot(const std::string& name, const std::filesystem::path& out) {
+  std::string stem = name;
+  std::replace(stem.begin(), stem.end(), '-', '_');
+  const std::filesystem::path script =
+      std::filesystem::path(NIMBUS_SOURCE_DIR) / "tools" / ("plot_" + stem + ".py");
+  if (!std::filesystem::exists(script)) return;
+  const std::string probe = fmt::format("{} -c 'import matplotlib' >/dev/null 2>&1", kPlotPython);
+  if (std::system(probe.c_str()) != 0) {
+    std::fprintf(stderr,
+                 "nimbus: note: no plot: %s with matplotlib is not available; the CSV files are "
+                 "in %s (plot later with %s %s %s)\n",
+                 kPlotPython, out.c_str(), kPlotPython, script.c_str(), out.c_str());
+    return;
+  }
+  const std::string command =
+      fmt::format("{} '{}' '{}'", kPlotPython, script.string(), out.string());
+  if (std::system(command.c_str()) != 0)
+    std::fprintf(stderr, "nimbus: note: %s failed; the CSV files are in %s\n", script.c_str(),
+                 out.c_str());
+}
+
+int run_experiment(const ExperimentArgs& args) {
+  using namespace nimbus;
+  const auto& all = experiments();
+  const auto it = std::find_if(all.begin(), all.end(),
+                               [&](const Experiment& e) { return e.name == args.name; });
+  if (it == all.end()) {
+    std::string names;
+    for (const Experiment& e : all) names += (names.empty() ? "" : ", ") + e.name;
+    std::fprintf(stderr, "nimbus: unknown experiment \"%s\" (one of: %s)\n", args.name.c_str(),
+                 names.c_str());
+    return kExitBadInput;
+  }
+  ExperimentOptions options;
+  options.out = args.out;
+  options.scenes = args.scenes;
+  options.quick = args.quick;
+  options.seed = uint64_t(args.seed);
+  options.threads = args.threads;
+  try {
+    std::filesystem::create_directories(options.out);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "nimbus: %s: cannot create the directory (%s)\n", args.out.c_str(),
+                 e.what());
+    return kExitBadInput;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  ExperimentReport report;
+  try {
+    report = it->run(options);
+  } catch (const SceneError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitBadInput;
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("%s (%s) in %.1f s\n%s", it->name.c_str(), args.quick ? "quick" : "full", seconds,
+              report.summary.c_str());
+  for (const auto& f : report.files) std::printf("  wrote %s\n", f.c_str());
+  if (!args.no_plot) plot(it->name, options.out);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -139,6 +221,23 @@ int main(int argc, char** argv) {
   render->add_option("--stats", args.stats, "Write render statistics as JSON to this file");
   render->add_flag("-q,--quiet", args.quiet, "Print nothing but errors");
 
+  ExperimentArgs exp;
+  std::string names;
+  for (const auto& e : nimbus::experiments()) names += "\n  " + e.name + ": " + e.description;
+  CLI::App* experiment = app.add_subcommand(
+      "experiment",
+      "Run a paper-reproduction experiment (docs/reproduction.md): CSV, plots, images");
+  experiment->add_option("name", exp.name, "Experiment:" + names)->required();
+  experiment->add_option("--out", exp.out, "Directory for the results (created if missing)")
+      ->required();
+  experiment->add_flag("--quick", exp.quick, "A tiny variant that runs in seconds");
+  experiment->add_option("--seed", exp.seed, "Random seed")->check(CLI::NonNegativeNumber);
+  experiment->add_option("--threads", exp.threads, "Worker threads (default: all cores)")
+      ->check(CLI::PositiveNumber);
+  experiment->add_option("--scenes", exp.scenes, "Directory of the scene files")
+      ->capture_default_str();
+  experiment->add_flag("--no-plot", exp.no_plot, "Write the CSV files only");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -146,6 +245,7 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : kExitBadInput;
   }
   try {
+    if (experiment->parsed()) return run_experiment(exp);
     return run_render(args);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "nimbus: %s\n", e.what());

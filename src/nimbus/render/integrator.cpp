@@ -1,5 +1,6 @@
 #include "nimbus/render/integrator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -59,24 +60,155 @@ Rgb direct_light(const Scene& scene, const Vec3& p, const Vec3& n, bool on_surfa
   return L;
 }
 
-bool russian_roulette(PathState& s, int depth, Rng& rng) {
+// Largest magnitude over channels: spectral tracking with a majorant that does not bound can
+// make weights negative.
+double max_abs(const Rgb& x) {
+  return std::max({std::abs(x[0]), std::abs(x[1]), std::abs(x[2])});
+}
+
+// Continues the path with probability q = min(1, max|beta / scale|) from depth 3 on.
+bool russian_roulette(Rgb& beta, double scale, int depth, Rng& rng) {
   if (depth < 3) return true;
-  const double q = std::min(1.0, s.beta.max());
+  const double q = std::min(1.0, max_abs(beta) / scale);
   if (q <= 0 || rng.uniform() >= q) return false;
-  s.beta /= q;  // unbiased: survivors carry 1/q
+  beta /= q;  // unbiased: survivors carry 1/q
   return true;
+}
+
+// Next-event estimation for spectral MIS (Miller et al. 2019, §6; pbrt-v4's SampleLd): the
+// shadow ray's T_ray, r_u and r_l from hero ratio tracking, the vertex pdfs folded in with r_p,
+// the path's r_u at the vertex, and the balance heuristic over channels and both techniques:
+//   f Li T_ray / avg(r_p (p_light r_l + p_f r_u)),  or f Li T_ray / avg(r_p r_l) for delta lights.
+template <class F, class Pdf>
+Rgb direct_light_mis(const Scene& scene, const Vec3& p, const Vec3& n, bool on_surface, int inside,
+                     int hero, const Rgb& r_p, F&& f, Pdf&& f_pdf, Rng& rng, Counters& counters) {
+  Rgb L(0.0);
+  for (const Light& light : scene.lights) {
+    const double u1 = rng.uniform(), u2 = rng.uniform();
+    const auto ls = sample_light(light, p, u1, u2);
+    if (!ls) continue;
+    if (on_surface && dot(ls->wi, n) <= 0) continue;
+    const Rgb fv = f(ls->wi);
+    if (fv.is_black()) continue;
+    const Vec3 o = on_surface ? offset_origin(scene, p, n, ls->wi) : p;
+    MisPath<3> shadow;
+    if (!transmittance_mis(scene, {o, ls->wi}, ls->distance * kShadowShrink, inside, hero, shadow,
+                           rng, counters))
+      continue;
+    if (ls->delta) {
+      L += fv * ls->Li * shadow.beta / (r_p * shadow.r_l).average();
+    } else {
+      const Rgb r_l = r_p * shadow.r_l * ls->pdf, r_u = r_p * shadow.r_u * f_pdf(ls->wi);
+      L += fv * ls->Li * shadow.beta / (r_l + r_u).average();
+    }
+  }
+  return L;
+}
+
+// The path tracer for spectral MIS: one hero channel per path for free-path sampling, every
+// contribution divided by the channel-averaged path pdfs (beta / avg(r_u), or
+// beta / avg(r_u + r_l) against next-event estimation). Surfaces as in `radiance`.
+Rgb radiance_spectral_mis(const Scene& scene, Ray ray, Rng& rng, Counters& counters) {
+  Rgb L(0.0);
+  MisPath<3> path;
+  const int hero = std::min(2, static_cast<int>(rng.uniform() * 3));
+  int inside = solid_containing(scene, ray.o);
+  bool specular = true;
+  Vec3 prev_p = ray.o;
+  // Radiance Le arriving along the ray from `light`, which next-event estimation also samples.
+  auto from_light = [&](const Rgb& Le, const Light& light) {
+    if (specular) return path.beta * Le / path.r_u.average();
+    const Rgb r_l = path.r_l * light_pdf(light, prev_p, ray.d);
+    return path.beta * Le / (path.r_u + r_l).average();
+  };
+
+  for (int depth = 0;; ++depth) {
+    ++counters.surface_rays;
+    const auto hit = intersect(scene, ray, kInf);
+    const double t_surface = hit ? hit->t : kInf;
+    const MediumEvent ev =
+        sample_collision_mis(scene, ray, t_surface, inside, hero, path, rng, counters);
+    L += ev.emitted;
+    if (ev.type == MediumEvent::Type::Absorb) break;
+    if (ev.type == MediumEvent::Type::Scatter) {
+      if (depth >= scene.settings.max_depth) break;
+      const Vec3 p = ray.at(ev.t);
+      const MediumPoint& m = ev.medium;
+      if (inside < 0)
+        L += path.beta * direct_light_mis(
+                             scene, p, {}, false, inside, hero, path.r_u,
+                             [&](const Vec3& wi) { return phase_value(m, dot(ray.d, wi)); },
+                             [&](const Vec3& wi) { return phase_pdf(m, dot(ray.d, wi)); }, rng,
+                             counters);
+      Rgb weight;
+      double pdf;
+      const double u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+      const Vec3 wi = sample_phase(m, ray.d, u0, u1, u2, weight, pdf);
+      path.beta *= weight;
+      path.r_l = path.r_u / pdf;
+      prev_p = p;
+      specular = false;
+      ray = {p, wi};
+      if (!russian_roulette(path.beta, path.r_u.average(), depth, rng)) break;
+      continue;
+    }
+
+    if (!hit) {
+      for (const Light& light : scene.lights)
+        if (light.type == Light::Type::Environment) L += from_light(light.radiance, light);
+      break;
+    }
+    if (hit->light >= 0) {
+      const Light& light = scene.lights[hit->light];
+      L += from_light(light.radiance, light);
+      break;
+    }
+    const SceneObject& obj = scene.objects[hit->object];
+    const Vec3 p = ray.at(hit->t);
+    const Vec3 n = outward_normal(obj, p);
+    if (obj.surface.type == Surface::Type::Emissive) {
+      if (dot(ray.d, n) < 0) L += path.beta * obj.surface.radiance / path.r_u.average();
+      break;
+    }
+    if (depth >= scene.settings.max_depth) break;
+
+    if (obj.surface.type == Surface::Type::Diffuse) {
+      const Vec3 ns = dot(ray.d, n) < 0 ? n : -n;
+      const Rgb f = obj.surface.albedo * kInvPi;
+      L += path.beta * direct_light_mis(
+                           scene, p, ns, true, inside, hero, path.r_u,
+                           [&](const Vec3& wi) { return f * dot(wi, ns); },
+                           [&](const Vec3& wi) { return dot(wi, ns) * kInvPi; }, rng, counters);
+      const double u1 = rng.uniform(), u2 = rng.uniform();
+      const Vec3 wi = sample_cosine_hemisphere(ns, u1, u2);
+      path.beta *= obj.surface.albedo;
+      path.r_l = path.r_u / (dot(wi, ns) * kInvPi);
+      prev_p = p;
+      specular = false;
+      ray = {offset_origin(scene, p, ns, wi), wi};
+    } else {
+      const DielectricSample ds = sample_dielectric(-ray.d, n, obj.surface.ior, rng.uniform());
+      if (!ds.reflected) inside = dot(ds.wi, n) < 0 ? hit->object : -1;
+      specular = true;
+      ray = {offset_origin(scene, p, n, ds.wi), ds.wi};
+    }
+    if (!russian_roulette(path.beta, path.r_u.average(), depth, rng)) break;
+  }
+  return L;
 }
 
 }  // namespace
 
 Rgb radiance(const Scene& scene, Ray ray, Rng& rng, Counters& counters) {
   ++counters.paths;
+  if (scene.settings.tracking.mode == TrackingSettings::Mode::SpectralMis)
+    return radiance_spectral_mis(scene, ray, rng, counters);
   Rgb L(0.0);
   PathState s;
   s.prev_p = ray.o;
   s.inside = solid_containing(scene, ray.o);
   // Delta tracking follows one channel per path, chosen uniformly when the path first meets a
-  // medium, and from then on carries its weight (times 3) to that channel only.
+  // medium (sample_collision), and from then on carries its weight (times 3) to that channel only.
   int channel = -1;
 
   auto mis_weight = [&](const Light& light) {
@@ -88,18 +220,10 @@ Rgb radiance(const Scene& scene, Ray ray, Rng& rng, Counters& counters) {
     const auto hit = intersect(scene, ray, kInf);
     const double t_surface = hit ? hit->t : kInf;
 
-    const int channel_before = channel;
     const MediumEvent ev =
-        sample_collision(scene, ray, t_surface, s.inside, channel, rng, counters);
-    if (channel != channel_before) {
-      const double b = s.beta[channel];
-      s.beta = Rgb(0.0);
-      s.beta[channel] = 3 * b;
-    }
-    if (ev.type == MediumEvent::Type::Absorb) {
-      L += s.beta * ev.emission;
-      break;
-    }
+        sample_collision(scene, ray, t_surface, s.inside, s.beta, channel, rng, counters);
+    L += ev.emitted;
+    if (ev.type == MediumEvent::Type::Absorb) break;
     if (ev.type == MediumEvent::Type::Scatter) {
       if (depth >= scene.settings.max_depth) break;
       const Vec3 p = ray.at(ev.t);
@@ -120,7 +244,7 @@ Rgb radiance(const Scene& scene, Ray ray, Rng& rng, Counters& counters) {
       s.prev_p = p;
       s.specular = false;
       ray = {p, wi};
-      if (!russian_roulette(s, depth, rng)) break;
+      if (!russian_roulette(s.beta, 1.0, depth, rng)) break;
       continue;
     }
 
@@ -164,7 +288,7 @@ Rgb radiance(const Scene& scene, Ray ray, Rng& rng, Counters& counters) {
       s.specular = true;
       ray = {offset_origin(scene, p, n, ds.wi), ds.wi};
     }
-    if (!russian_roulette(s, depth, rng)) break;
+    if (!russian_roulette(s.beta, 1.0, depth, rng)) break;
   }
   return L;
 }

@@ -1,0 +1,142 @@
+#pragma once
+// Null-scattering spectral MIS (Miller, Georgiev & Jarosz 2019, §5–6), the form pbrt-v4's
+// VolPathIntegrator uses. Free paths are sampled with one channel's majorant, the hero h, and the
+// path carries, per channel λ, its throughput beta and two path pdfs rescaled by the hero's
+// unidirectional pdf: r_u (the path as the unidirectional technique would sample it with λ as
+// hero) and r_l (as light sampling would). A contribution f is then scored as
+//   f / avg_λ p_λ = beta / avg(r_u)                  (one-sample MIS over the hero, balance)
+//   f / avg_λ (p_u,λ + p_l,λ) = beta / avg(r_u + r_l) (with MIS against next-event estimation).
+// Along a majorant segment of per-channel rates mu_maj, with T_maj = exp(−mu_maj Δt) since the
+// last tentative collision (eq. numbers from Miller et al.):
+//   scatter  pdf = T_maj[h] mu_s[h]:  beta, r_u *= T_maj mu_s / pdf
+//   null     pdf = T_maj[h] mu_n[h]:  beta, r_u *= T_maj mu_n / pdf,  r_l *= T_maj mu_maj / pdf
+//   escape   beta, r_u, r_l *= T_maj / T_maj[h]
+//   emission scored at every tentative collision: beta T_maj/pdf mu_a L_e / avg(r_u mu_maj
+//   T_maj/pdf)
+//            with pdf = T_maj[h] mu_maj[h]
+// The hero's events are drawn with P_a = mu_a[h]/mu_maj[h], P_s = mu_s[h]/mu_maj[h] and
+// P_n = max(0, 1 − P_a − P_s); mu_n = max(0, mu_maj − mu_t). Where mu_t[h] > mu_maj[h] the
+// probabilities are renormalised, the point is counted in `counters.clamped`, and the estimate is
+// biased: this estimator needs bounding majorants.
+
+#include <algorithm>
+#include <cmath>
+
+#include "nimbus/math/rng.h"
+#include "nimbus/tracking/counters.h"
+#include "nimbus/tracking/delta_tracking.h"
+#include "nimbus/tracking/free_flight.h"
+#include "nimbus/tracking/medium_sample.h"
+
+namespace nimbus {
+
+template <int N>
+struct MisPath {
+  Spectrum<N> beta{1.0}, r_u{1.0}, r_l{1.0};
+};
+
+template <int N>
+Spectrum<N> clamp_zero(const Spectrum<N>& s) {
+  Spectrum<N> r;
+  for (int i = 0; i < N; ++i) r[i] = std::max(0.0, s[i]);
+  return r;
+}
+
+// Tracks [t0, t1] with hero channel h until a real collision or the segment's end; updates the
+// path and adds the weighted emission to `emitted`.
+template <int N, class Lookup>
+Collision hero_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>& mu_maj, int h,
+                        MisPath<N>& path, Spectrum<N>& emitted, Rng& rng,
+                        TrackingCounters& counters) {
+  for (double t = t0;;) {
+    const double dt = mu_maj[h] > 0 ? free_flight(mu_maj[h], rng.uniform()) : t1 - t;
+    if (t + dt >= t1) {
+      const Spectrum<N> T_maj = exp(mu_maj * (t - t1));
+      path.beta *= T_maj / T_maj[h];
+      path.r_u *= T_maj / T_maj[h];
+      path.r_l *= T_maj / T_maj[h];
+      return {CollisionEvent::Escape, t1};
+    }
+    t += dt;
+    ++counters.tentative_collisions;
+    ++counters.lookups;
+    const MediumSample<N> m = lookup(t);
+    const Spectrum<N> T_maj = exp(mu_maj * -dt);
+    const Spectrum<N> mu_a_Le = m.mu_a * m.L_e;
+    if (!mu_a_Le.is_black()) {
+      const double pdf = T_maj[h] * mu_maj[h];
+      const Spectrum<N> r_e = path.r_u * mu_maj * T_maj / pdf;
+      if (r_e.average() > 0) emitted += path.beta * T_maj / pdf * mu_a_Le / r_e.average();
+    }
+    double P_a = m.mu_a[h] / mu_maj[h], P_s = m.mu_s[h] / mu_maj[h];
+    if (P_a + P_s > 1) {
+      ++counters.clamped;
+      P_a /= P_a + P_s;
+      P_s = 1 - P_a;
+    }
+    const double u = rng.uniform();
+    if (u < P_a) {
+      path.beta = Spectrum<N>(0.0);
+      return {CollisionEvent::Absorb, t};
+    }
+    if (u < P_a + P_s) {
+      const double pdf = T_maj[h] * m.mu_s[h];
+      path.beta *= T_maj * m.mu_s / pdf;
+      path.r_u *= T_maj * m.mu_s / pdf;
+      return {CollisionEvent::Scatter, t};
+    }
+    const Spectrum<N> mu_n = clamp_zero(mu_maj - m.mu_t());
+    const double pdf = T_maj[h] * mu_n[h];
+    if (pdf > 0) {
+      path.beta *= T_maj * mu_n / pdf;
+      path.r_u *= T_maj * mu_n / pdf;
+      path.r_l *= T_maj * mu_maj / pdf;
+    }
+    if (!(pdf > 0) || path.beta.is_black() || path.r_u.is_black()) {
+      path.beta = Spectrum<N>(0.0);
+      return {CollisionEvent::Absorb, t};
+    }
+  }
+}
+
+// Ratio tracking of a shadow segment for spectral MIS: T_ray (in `path.beta`) and the light and
+// unidirectional pdfs rescaled by the hero's light-path pdf (pdf = T_maj[h] mu_maj[h] per
+// tentative collision):  T_ray *= T_maj mu_n / pdf,  r_l *= T_maj mu_maj / pdf,
+// r_u *= T_maj mu_n / pdf, and at the end all three *= T_maj / T_maj[h]. The transmittance is
+// T_ray / avg(r_u + r_l) once multiplied by the vertex pdfs. Russian roulette (q = 3/4) where
+// that estimate falls below 0.05. Returns false once T_ray is 0.
+template <int N, class Lookup>
+bool hero_ratio_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>& mu_maj, int h,
+                         MisPath<N>& path, Rng& rng, TrackingCounters& counters) {
+  for (double t = t0;;) {
+    const double dt = mu_maj[h] > 0 ? free_flight(mu_maj[h], rng.uniform()) : t1 - t;
+    if (t + dt >= t1) {
+      const Spectrum<N> T_maj = exp(mu_maj * (t - t1));
+      path.beta *= T_maj / T_maj[h];
+      path.r_u *= T_maj / T_maj[h];
+      path.r_l *= T_maj / T_maj[h];
+      return true;
+    }
+    t += dt;
+    ++counters.tentative_collisions;
+    ++counters.lookups;
+    const MediumSample<N> m = lookup(t);
+    const Spectrum<N> T_maj = exp(mu_maj * -dt);
+    const Spectrum<N> mu_n = clamp_zero(mu_maj - m.mu_t());
+    if (m.mu_t()[h] > mu_maj[h]) ++counters.clamped;
+    const double pdf = T_maj[h] * mu_maj[h];
+    path.beta *= T_maj * mu_n / pdf;
+    path.r_l *= T_maj * mu_maj / pdf;
+    path.r_u *= T_maj * mu_n / pdf;
+    const Spectrum<N> T = path.beta / (path.r_u + path.r_l).average();
+    if (T.max() < 0.05) {
+      if (rng.uniform() < 0.75)
+        path.beta = Spectrum<N>(0.0);
+      else
+        path.beta /= 0.25;
+    }
+    if (path.beta.is_black()) return false;
+  }
+}
+
+}  // namespace nimbus

@@ -1,0 +1,41 @@
+#pragma once
+// Spectral tracking (Kutz et al. 2017; paper §3): one free path for all channels along [t0, t1],
+// tentative collisions at a scalar rate mu_bar (meant to be >= max_λ mu_t, but any mu_bar > 0 is
+// unbiased), an event at each drawn by `weighted_collision` under the caller's rule, until a real
+// event (absorption or scattering) or the end of the segment.
+//
+// On return, w holds the path weight: for Escape, E[w] = w_in · exp(−∫_{t0}^{t1} mu_t) per channel;
+// `emitted` has the weighted emission collected on the way added to it.
+
+#include "nimbus/math/rng.h"
+#include "nimbus/tracking/counters.h"
+#include "nimbus/tracking/delta_tracking.h"
+#include "nimbus/tracking/free_flight.h"
+#include "nimbus/tracking/weighted_collision.h"
+
+namespace nimbus {
+
+template <int N, class Lookup>
+Collision spectral_tracking(Lookup&& lookup, double t0, double t1, double mu_bar,
+                            const EventPolicy& policy, Spectrum<N>& w, Spectrum<N>& emitted,
+                            Rng& rng, TrackingCounters& counters) {
+  if (!(mu_bar > 0)) return {CollisionEvent::Escape, t1};
+  for (double t = t0;;) {
+    t += free_flight(mu_bar, rng.uniform());
+    if (t >= t1) return {CollisionEvent::Escape, t1};
+    ++counters.tentative_collisions;
+    ++counters.lookups;
+    const MediumSample<N> m = lookup(t);
+    const Spectrum<N> mu_n = Spectrum<N>(mu_bar) - m.mu_t();  // eq. 5: mu_n = mu_bar − mu_t
+    switch (weighted_collision(m, mu_n, mu_bar, policy, w, emitted, rng.uniform())) {
+      case TentativeEvent::Absorb:
+        return {CollisionEvent::Absorb, t};
+      case TentativeEvent::Scatter:
+        return {CollisionEvent::Scatter, t};
+      case TentativeEvent::Null:
+        break;
+    }
+  }
+}
+
+}  // namespace nimbus
