@@ -14,9 +14,7 @@ struct Medium {
   double g = 0;       // Henyey–Greenstein asymmetry; 0 is isotropic
   Density density = Density::Constant;
   double scale = 1;        // multiplies every density model
-  CloudDensity cloud;      // Cloud: density from F and noise
-  double density_max = 1;  // an upper bound of the density over the object
-  double density_min = 0;  // a lower bound of the density inside the object
+  CloudDensity cloud;  // Cloud: density from F and noise
 };
 
 }  // namespace nimbus

@@ -19,20 +19,17 @@ MediumSample<3> as_sample(const MediumPoint& m) {
 MediumEvent sample_collision(const Scene& scene, const Ray& ray, double t_max, int inside,
                              int& channel, Rng& rng, Counters& counters) {
   MediumEvent ev;
-  const MajorantSegments segs = majorant_segments(scene, ray, 0, t_max, inside);
-  if (segs.count == 0) return ev;
-  if (channel < 0) channel = std::min(2, static_cast<int>(rng.uniform() * 3));
   // The last lookup is the one at the collision that ends tracking: keep it.
   MediumPoint last;
   auto lookup = [&](double t) {
     last = medium_at(scene, ray.at(t), inside);
     return as_sample(last);
   };
-  for (int i = 0; i < segs.count; ++i) {
-    const MajorantSegment& seg = segs.seg[i];
+  walk_majorant_segments(scene, ray, 0, t_max, inside, [&](const MajorantSegment& seg) {
+    if (channel < 0) channel = std::min(2, static_cast<int>(rng.uniform() * 3));
     const Collision c = delta_tracking<3>(lookup, seg.t0, seg.t1, seg.mu_bar[channel], channel, rng,
                                           counters.tracking);
-    if (c.event == CollisionEvent::Escape) continue;
+    if (c.event == CollisionEvent::Escape) return true;
     ++counters.real_collisions;
     ev.t = c.t;
     ev.medium = last;
@@ -43,8 +40,8 @@ MediumEvent sample_collision(const Scene& scene, const Ray& ray, double t_max, i
       ev.type = MediumEvent::Type::Absorb;
       ev.emission = as_sample(last).L_e;
     }
-    return ev;
-  }
+    return false;
+  });
   return ev;
 }
 
@@ -52,13 +49,12 @@ Rgb transmittance(const Scene& scene, const Ray& ray, double t_max, int inside, 
                   Counters& counters) {
   ++counters.shadow_rays;
   if (occluded(scene, ray, t_max)) return Rgb(0.0);
-  const MajorantSegments segs = majorant_segments(scene, ray, 0, t_max, inside);
   auto lookup = [&](double t) { return as_sample(medium_at(scene, ray.at(t), inside)); };
   Rgb T(1.0);
-  for (int i = 0; i < segs.count && !T.is_black(); ++i) {
-    const MajorantSegment& seg = segs.seg[i];
+  walk_majorant_segments(scene, ray, 0, t_max, inside, [&](const MajorantSegment& seg) {
     T *= ratio_tracking<3>(lookup, seg.t0, seg.t1, seg.mu_bar.max(), rng, counters.tracking);
-  }
+    return !T.is_black();
+  });
   return T;
 }
 
