@@ -13,7 +13,7 @@ struct Medium {
   Rgb emission{0.0};  // L_e, entering the RTE as mu_a L_e (eq. 4)
   double g = 0;       // Henyey–Greenstein asymmetry; 0 is isotropic
   Density density = Density::Constant;
-  double scale = 1;        // multiplies every density model
+  double scale = 1;    // multiplies every density model
   CloudDensity cloud;  // Cloud: density from F and noise
 };
 

@@ -86,18 +86,73 @@ Box box_of(const Vec3& center, const Vec3& half) {
   return {center - half, center + half};
 }
 
+// The mean chord of the rays crossing a box, 4 V / S (Cauchy).
+double mean_chord(const Vec3& half) {
+  return 4 * half.x * half.y * half.z / (half.x * half.y + half.y * half.z + half.x * half.z);
+}
+
+// The tree as built and the arrays that place its nodes, all in breadth-first order.
+struct Grown {
+  std::vector<OctreeNode> nodes;
+  std::vector<Vec3> centers;
+  std::vector<int> levels;
+};
+
+// Undoes the splits that do not pay for themselves, bottom up, and compacts the tree. The cost
+// of a ray crossing a leaf is one step plus kOctreeLookupCost per expected null collision there,
+// (mu_bar − mu_c) times the mean chord; an interior node costs one step plus its children's
+// costs, each crossed with probability 1/4 (the ratio of their surfaces). Where the leaf is
+// cheaper the children go: a split that only halves the size without tightening the bounds
+// costs traversal for nothing.
+Grown prune(Grown g, const MajorantOctree& tree) {
+  std::vector<double> cost(g.nodes.size());
+  for (size_t i = g.nodes.size(); i-- > 0;) {
+    OctreeNode& n = g.nodes[i];
+    const double leaf = n.empty ? 1.0
+                                : 1.0 + kOctreeLookupCost * (n.mu_bar - n.mu_c).max() *
+                                            mean_chord(tree.half[g.levels[i]]);
+    cost[i] = leaf;
+    if (n.children < 0) continue;
+    double split = 0;
+    for (int k = 0; k < 8; ++k) split += cost[n.children + k];
+    split = 1.0 + 0.25 * split;
+    if (split < leaf)
+      cost[i] = split;
+    else
+      n.children = -1;
+  }
+  // Breadth first again, over what is left: children stay contiguous and after their parent.
+  Grown out;
+  out.nodes.push_back(g.nodes[0]);
+  out.centers.push_back(g.centers[0]);
+  out.levels.push_back(0);
+  std::vector<size_t> from{0};
+  for (size_t i = 0; i < out.nodes.size(); ++i) {
+    const std::int32_t old_children = g.nodes[from[i]].children;
+    if (old_children < 0) continue;
+    out.nodes[i].children = static_cast<std::int32_t>(out.nodes.size());
+    for (int k = 0; k < 8; ++k) {
+      const size_t c = static_cast<size_t>(old_children) + k;
+      out.nodes.push_back(g.nodes[c]);
+      out.centers.push_back(g.centers[c]);
+      out.levels.push_back(g.levels[c]);
+      from.push_back(c);
+    }
+  }
+  return out;
+}
+
 // The paper's preliminary pass: min and max of mu_t at random points of each non-empty leaf.
 // Interior nodes then hold the hull of their children.
 void sample_bounds(const Scene& scene, int inside, const std::vector<Vec3>& centers,
-                   const std::vector<int>& levels, const Vec3& root_half,
+                   const std::vector<int>& levels, const MajorantOctree& tree,
                    std::vector<OctreeNode>& nodes) {
   const int samples = std::max(1, scene.settings.tracking.majorant_samples);
   const uint64_t seed = splitmix64(scene.settings.seed ^ 0x6f637472656573ull);
   tbb::parallel_for(size_t{0}, nodes.size(), [&](size_t i) {
     OctreeNode& n = nodes[i];
     if (n.children >= 0 || n.empty) return;
-    const Vec3 half = root_half * std::ldexp(1.0, -levels[i]);
-    const Box box = box_of(centers[i], half);
+    const Box box = box_of(centers[i], tree.half[levels[i]]);
     Rng rng(seed, i);
     Rgb lo(Box::kInf), hi(0.0);
     for (int s = 0; s < samples; ++s) {
@@ -150,7 +205,8 @@ MajorantOctree build_majorant_octree(const Scene& scene, int inside) {
   for (const Member& m : members) tree.box = unite(tree.box, m.object->bounds);
   if (tree.box.empty()) return tree;
   const bool solid = inside >= 0;
-  const Vec3 root_half = tree.box.extent() * 0.5;
+  tree.half[0] = tree.box.extent() * 0.5;
+  for (int l = 1; l <= kOctreeMaxDepth; ++l) tree.half[l] = tree.half[l - 1] * 0.5;
 
   auto make_node = [&](const Vec3& center, const Vec3& half) {
     const Bounds3 b = interval_bounds(members, box_of(center, half), solid);
@@ -161,13 +217,13 @@ MajorantOctree build_majorant_octree(const Scene& scene, int inside) {
     return n;
   };
   // Node centers are computed as the walk computes them, so both see the same boxes.
-  std::vector<OctreeNode> nodes{make_node(tree.box.center(), root_half)};
+  std::vector<OctreeNode> nodes{make_node(tree.box.center(), tree.half[0])};
   std::vector<Vec3> centers{tree.box.center()};
   std::vector<int> levels{0};
   const int max_depth = std::clamp(settings.octree_depth, 0, kOctreeMaxDepth);
   size_t begin = 0, end = 1;
   for (int level = 0; level < max_depth; ++level) {
-    const Vec3 half = root_half * std::ldexp(1.0, -level);
+    const Vec3& half = tree.half[level];
     struct Candidate {
       double priority;
       size_t node;
@@ -186,7 +242,7 @@ MajorantOctree build_majorant_octree(const Scene& scene, int inside) {
                 [](const Candidate& a, const Candidate& b) { return a.node < b.node; });
     }
     if (split.empty()) break;
-    const Vec3 child_half = half * 0.5;
+    const Vec3& child_half = tree.half[level + 1];
     nodes.resize(end + 8 * split.size());
     centers.resize(nodes.size());
     levels.resize(nodes.size(), level + 1);
@@ -202,11 +258,12 @@ MajorantOctree build_majorant_octree(const Scene& scene, int inside) {
     });
     begin = end;
     end = nodes.size();
-    tree.depth = level + 1;
   }
+  Grown g = prune({std::move(nodes), std::move(centers), std::move(levels)}, tree);
+  tree.depth = *std::max_element(g.levels.begin(), g.levels.end());
   if (settings.majorant_source == TrackingSettings::MajorantSource::Sample)
-    sample_bounds(scene, inside, centers, levels, root_half, nodes);
-  tree.nodes = std::move(nodes);
+    sample_bounds(scene, inside, g.centers, g.levels, tree, g.nodes);
+  tree.nodes = std::move(g.nodes);
   tree.build_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return tree;

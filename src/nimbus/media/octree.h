@@ -17,9 +17,13 @@
 // most that many null collisions, which no split can improve much). The tree is built level by
 // level; when the next level would exceed kOctreeMaxNodes, only the nodes with the largest
 // null optical depth (max_c (mu_bar − mu_c) · diagonal) are split, so memory stays bounded at
-// any depth and the tree does not depend on the number of threads.
+// any depth and the tree does not depend on the number of threads. Then splits that do not pay
+// for themselves are undone, bottom up, by a cost model like a BVH's surface area heuristic:
+// a leaf costs a walk step plus kOctreeLookupCost per expected null collision of a ray crossing
+// it, an interior node a step plus its children's costs weighted by the chance a ray crossing
+// the node crosses them.
 
-#include <cmath>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <utility>
@@ -37,6 +41,8 @@ inline constexpr int kOctreeMaxDepth = 16;
 inline constexpr double kOctreeHomogeneous = 0.02;
 inline constexpr double kOctreeThinNull = 0.05;
 inline constexpr std::size_t kOctreeMaxNodes = std::size_t{1} << 18;
+// What a density lookup costs in steps of the walk, for deciding which splits pay off.
+inline constexpr double kOctreeLookupCost = 16;
 
 struct OctreeNode {
   Rgb mu_bar{0.0};  // majorant of mu_t (the majorant scale is applied by the walk)
@@ -48,7 +54,10 @@ struct OctreeNode {
 };
 
 struct MajorantOctree {
-  Box box;                        // the root's box; empty when there is no medium
+  Box box;  // the root's box; empty when there is no medium
+  // Half the extent of a node at each level; the build and the walk both place children with it,
+  // so they agree on every box to the last bit.
+  std::array<Vec3, kOctreeMaxDepth + 1> half{};
   std::vector<OctreeNode> nodes;  // breadth first, nodes[0] the root; empty when no medium
   int depth = 0;                  // deepest level reached
   double build_seconds = 0;
@@ -73,7 +82,6 @@ bool walk_octree(const MajorantOctree& tree, const Ray& ray, double t_min, doubl
   if (tree.nodes.empty()) return true;
   double t0 = t_min, t1 = t_max;
   if (!clip_ray(tree.box, ray, t0, t1) || !(t1 > t0)) return true;
-  const Vec3 root_half = tree.box.extent() * 0.5;
   Vec3 inv;
   for (int k = 0; k < 3; ++k) inv[k] = 1.0 / ray.d[k];
   struct Item {
@@ -103,7 +111,7 @@ bool walk_octree(const MajorantOctree& tree, const Ray& ray, double t_min, doubl
     for (int i = 2; i < n; ++i)
       for (int j = i; j > 1 && cuts[j] < cuts[j - 1]; --j) std::swap(cuts[j], cuts[j - 1]);
     cuts[n] = it.t1;
-    const Vec3 half = root_half * std::ldexp(1.0, -(it.level + 1));
+    const Vec3& half = tree.half[it.level + 1];
     for (int i = n - 1; i >= 0; --i) {
       const double a = cuts[i], b = cuts[i + 1];
       if (!(b > a)) continue;

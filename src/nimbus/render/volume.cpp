@@ -26,6 +26,7 @@ MediumEvent sample_collision(const Scene& scene, const Ray& ray, double t_max, i
     return as_sample(last);
   };
   walk_majorant_segments(scene, ray, 0, t_max, inside, [&](const MajorantSegment& seg) {
+    ++counters.majorant_segments;
     if (channel < 0) channel = std::min(2, static_cast<int>(rng.uniform() * 3));
     const Collision c = delta_tracking<3>(lookup, seg.t0, seg.t1, seg.mu_bar[channel], channel, rng,
                                           counters.tracking);
@@ -52,6 +53,7 @@ Rgb transmittance(const Scene& scene, const Ray& ray, double t_max, int inside, 
   auto lookup = [&](double t) { return as_sample(medium_at(scene, ray.at(t), inside)); };
   Rgb T(1.0);
   walk_majorant_segments(scene, ray, 0, t_max, inside, [&](const MajorantSegment& seg) {
+    ++counters.majorant_segments;
     T *= ratio_tracking<3>(lookup, seg.t0, seg.t1, seg.mu_bar.max(), rng, counters.tracking);
     return !T.is_black();
   });
