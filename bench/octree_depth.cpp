@@ -2,10 +2,14 @@
 // cost. Renders a scene at each depth with the same samples and seed and writes one CSV row per
 // depth; tools/plot_octree_depth.py draws it.
 //
-//   octree_depth SCENE OUT.csv [--spp N] [--threads N] [--depths 0,1,2,4,8,12,16]
+//   octree_depth SCENE OUT.csv [--spp N] [--threads N] [--repeat N] [--depths 0,1,2,4,8,12,16]
+//
+// With --repeat, each depth is built and rendered N times and the shortest times are kept: on a
+// shared machine the least disturbed run is the best estimate (the counters are identical).
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -39,11 +43,12 @@ std::vector<int> parse_depths(const std::string& list) {
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::cerr << "usage: octree_depth SCENE OUT.csv [--spp N] [--threads N] [--depths LIST]\n";
+    std::cerr << "usage: octree_depth SCENE OUT.csv [--spp N] [--threads N] [--repeat N] "
+                 "[--depths LIST]\n";
     return 2;
   }
   const std::string scene_path = argv[1], csv_path = argv[2];
-  int spp = 4, threads = 0;
+  int spp = 4, threads = 0, repeat = 1;
   std::vector<int> depths{0, 1, 2, 4, 8, 12, 16};
   for (int i = 3; i + 1 < argc; i += 2) {
     const std::string key = argv[i], value = argv[i + 1];
@@ -51,6 +56,8 @@ int main(int argc, char** argv) {
       spp = std::stoi(value);
     else if (key == "--threads")
       threads = std::stoi(value);
+    else if (key == "--repeat")
+      repeat = std::max(1, std::stoi(value));
     else if (key == "--depths")
       depths = parse_depths(value);
     else {
@@ -60,18 +67,26 @@ int main(int argc, char** argv) {
   }
   std::vector<Row> rows;
   for (int depth : depths) {
-    const nimbus::Scene scene = nimbus::compile_scene(nimbus::load_scene_file(
+    const nimbus::SceneDesc desc = nimbus::load_scene_file(
         scene_path,
-        {fmt::format("integrator.octree.depth={}", depth), fmt::format("integrator.spp={}", spp)}));
-    const nimbus::RenderResult r = nimbus::render(scene, {threads, {}});
+        {fmt::format("integrator.octree.depth={}", depth), fmt::format("integrator.spp={}", spp)});
+    nimbus::Scene scene = nimbus::compile_scene(desc);
+    nimbus::RenderResult r = nimbus::render(scene, {threads, {}});
+    double build_seconds = scene.field_octree.build_seconds, render_seconds = r.seconds;
+    for (int i = 1; i < repeat; ++i) {
+      scene = nimbus::compile_scene(desc);
+      r = nimbus::render(scene, {threads, {}});
+      build_seconds = std::min(build_seconds, scene.field_octree.build_seconds);
+      render_seconds = std::min(render_seconds, r.seconds);
+    }
     const nimbus::Counters& c = r.counters;
     const double samples = double(scene.settings.width) * scene.settings.height * spp;
     Row row{depth,
-            scene.field_octree.build_seconds,
+            build_seconds,
             scene.field_octree.nodes.size(),
             scene.field_octree.bytes(),
             scene.field_octree.depth,
-            r.seconds,
+            render_seconds,
             double(c.tracking.lookups) / samples,
             double(c.majorant_segments) / samples,
             double(c.null_collisions()) / double(c.tracking.tentative_collisions),
