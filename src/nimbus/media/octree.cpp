@@ -48,6 +48,8 @@ bool density_range(const Member& m, const Box& box, bool solid, double& lo, doub
       break;
     }
   }
+  // Where the box reaches past the object's bounds there are points without this medium.
+  if (!(b.lo == box.lo && b.hi == box.hi)) lo = 0;
   return true;
 }
 
@@ -59,7 +61,8 @@ Bounds3 interval_bounds(const std::vector<Member>& members, const Box& box, bool
   Bounds3 r;
   for (const Member& m : members) {
     double lo = 0, hi = 0;
-    if (!density_range(m, box, solid, lo, hi)) continue;
+    // A density bounded by 0 (a cloud eroded away near its surface) is no medium either.
+    if (!density_range(m, box, solid, lo, hi) || !(hi > 0)) continue;
     const Rgb sigma_t = m.medium->sigma_a + m.medium->sigma_s;
     r.hi += sigma_t * hi;
     r.lo += sigma_t * lo;
