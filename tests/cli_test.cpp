@@ -193,6 +193,13 @@ TEST_F(Cli, RendersDefaultOutputsAndStats) {
     EXPECT_GT(s["image_mean_standard_error"][c].get<double>(), 0);
   }
   EXPECT_GT(s["counters"]["density_lookups"].get<long>(), 0);
+  const double null_fraction = s["counters"]["null_collision_fraction"].get<double>();
+  EXPECT_TRUE(null_fraction >= 0 && null_fraction < 1);
+  EXPECT_GT(s["counters"]["density_lookups_per_real_collision"].get<double>(), 0);
+  EXPECT_GT(s["octree"]["nodes"].get<long>(), 0);
+  EXPECT_GT(s["octree"]["bytes"].get<long>(), 0);
+  EXPECT_GE(s["octree"]["build_seconds"].get<double>(), 0);
+  EXPECT_GE(s["octree"]["depth"].get<int>(), 0);
 }
 
 TEST_F(Cli, OutputIsTheSameForOneAndTwoThreads) {

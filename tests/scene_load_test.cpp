@@ -134,9 +134,9 @@ std::vector<BadScene> bad_scenes() {
        {},
        "scene.json: /integrator/decomposition: expected true or false, not a string"},
       {"octree too deep",
-       with_camera(R"("integrator": {"octree": {"depth": 11}})"),
+       with_camera(R"("integrator": {"octree": {"depth": 17}})"),
        {},
-       "scene.json: /integrator/octree/depth: must be in [0, 10]"},
+       "scene.json: /integrator/octree/depth: must be in [0, 16]"},
       {"zero light direction",
        with_camera(
            R"("lights": [{"type": "directional", "direction": [0, 0, 0], "irradiance": 1}])"),

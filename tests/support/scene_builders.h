@@ -1,10 +1,9 @@
 #pragma once
 // Building small scenes in code for renderer tests, as compile_scene would from a file.
 
-#include <algorithm>
-
 #include "nimbus/frep/bounds.h"
 #include "nimbus/frep/tape.h"
+#include "nimbus/media/octree.h"
 #include "nimbus/render/scene.h"
 
 namespace nimbus::test {
@@ -27,20 +26,12 @@ inline SceneObject object_of(const ShapePtr& shape, Surface::Type surface, int m
   return obj;
 }
 
-// Field objects and density bounds, as compile_scene derives them.
+// Field objects and majorant octrees, as compile_scene derives them.
 inline void finish_media(Scene& scene) {
   for (size_t i = 0; i < scene.objects.size(); ++i)
     if (scene.objects[i].surface.type == Surface::Type::None && scene.objects[i].medium >= 0)
       scene.field_objects.push_back(static_cast<int>(i));
-  for (const SceneObject& obj : scene.objects) {
-    if (obj.medium < 0) continue;
-    Medium& m = scene.media[obj.medium];
-    const Interval F = evaluate(obj.tape, obj.bounds);
-    if (m.density == Medium::Density::Field) m.density_max = m.scale * std::max(F.hi, 0.0);
-    if (m.density == Medium::Density::Cloud)
-      m.density_max = m.scale * cloud_density_range(F.lo, F.hi, m.cloud.params).second;
-    if (m.density == Medium::Density::Constant) m.density_min = m.density_max = m.scale;
-  }
+  build_majorant_octrees(scene);
 }
 
 }  // namespace nimbus::test

@@ -13,10 +13,8 @@ struct Medium {
   Rgb emission{0.0};  // L_e, entering the RTE as mu_a L_e (eq. 4)
   double g = 0;       // Henyey–Greenstein asymmetry; 0 is isotropic
   Density density = Density::Constant;
-  double scale = 1;        // multiplies every density model
-  CloudDensity cloud;      // Cloud: density from F and noise
-  double density_max = 1;  // an upper bound of the density over the object
-  double density_min = 0;  // a lower bound of the density inside the object
+  double scale = 1;    // multiplies every density model
+  CloudDensity cloud;  // Cloud: density from F and noise
 };
 
 }  // namespace nimbus

@@ -31,10 +31,6 @@ void add_medium(MediumPoint& m, const Medium& medium, double density) {
   ++m.media;
 }
 
-Rgb majorant_of(const Medium& medium) {
-  return (medium.sigma_a + medium.sigma_s) * medium.density_max;
-}
-
 }  // namespace
 
 MediumPoint medium_at(const Scene& scene, const Vec3& x, int inside) {
@@ -57,52 +53,6 @@ MediumPoint medium_at(const Scene& scene, const Vec3& x, int inside) {
     add_medium(m, medium, density_at(medium, x, F));
   }
   return m;
-}
-
-MajorantSegments majorant_segments(const Scene& scene, const Ray& ray, double t_min, double t_max,
-                                   int inside) {
-  MajorantSegments out;
-  const double scale = scene.settings.tracking.majorant_scale;
-  if (inside >= 0) {
-    const int mi = scene.objects[inside].medium;
-    if (mi >= 0) {
-      const Medium& m = scene.media[mi];
-      out.seg[out.count++] = {t_min, t_max, majorant_of(m) * scale,
-                              (m.sigma_a + m.sigma_s) * m.density_min};
-    }
-    return out;
-  }
-  // Each field object's bounds along the ray; the majorant of a stretch is the sum of those
-  // that cover it.
-  struct Span {
-    double t0, t1;
-    Rgb mu_bar;
-  };
-  std::array<Span, MediumPoint::kMaxMedia> spans;
-  std::array<double, 2 * MediumPoint::kMaxMedia> cuts;
-  int n = 0, ncuts = 0;
-  for (int i : scene.field_objects) {
-    double t0 = t_min, t1 = t_max;
-    if (!clip_ray(scene.objects[i].bounds, ray, t0, t1) || t1 <= t0) continue;
-    spans[n++] = {t0, t1, majorant_of(scene.media[scene.objects[i].medium])};
-    cuts[ncuts++] = t0;
-    cuts[ncuts++] = t1;
-  }
-  std::sort(cuts.begin(), cuts.begin() + ncuts);
-  for (int k = 0; k + 1 < ncuts; ++k) {
-    const double a = cuts[k], b = cuts[k + 1];
-    if (b <= a) continue;
-    const double mid = 0.5 * (a + b);
-    Rgb mu_bar(0.0);
-    bool covered = false;
-    for (int s = 0; s < n; ++s)
-      if (spans[s].t0 <= mid && mid <= spans[s].t1) {
-        mu_bar += spans[s].mu_bar;
-        covered = true;
-      }
-    if (covered) out.seg[out.count++] = {a, b, mu_bar * scale};
-  }
-  return out;
 }
 
 Rgb phase_value(const MediumPoint& m, double cos_theta) {

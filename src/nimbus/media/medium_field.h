@@ -4,15 +4,16 @@
 // medium) only that object's medium is present: a solid displaces the media around it.
 
 #include <array>
+#include <utility>
 #include <vector>
 
 #include "nimbus/math/ray.h"
 #include "nimbus/media/medium.h"
+#include "nimbus/media/octree.h"
+#include "nimbus/render/scene.h"
 #include "nimbus/spectral/spectrum.h"
 
 namespace nimbus {
-
-struct Scene;
 
 // The coefficients at a point, with the phase function of the mixture of media present there.
 struct MediumPoint {
@@ -36,15 +37,35 @@ struct MajorantSegment {
   Rgb mu_c{0.0};
 };
 
-// Majorant segments covering the media along the ray in [t_min, t_max], in order, with gaps
-// where no medium can be. At most kMaxSegments; the ray direction must be unit length.
-struct MajorantSegments {
-  static constexpr int kMaxSegments = 2 * MediumPoint::kMaxMedia + 1;
-  std::array<MajorantSegment, kMaxSegments> seg;
-  int count = 0;
-};
-MajorantSegments majorant_segments(const Scene& scene, const Ray& ray, double t_min, double t_max,
-                                   int inside);
+// Calls f(const MajorantSegment&) for the majorant segments covering the media along the ray in
+// [t_min, t_max], in order, from the leaves of the scene's majorant octree (octree.h) for
+// `inside` (-1: the field; else that solid object). Where no medium can be there is a gap;
+// neighbouring leaves with identical bounds become one segment. f returns false to stop the
+// walk. The ray direction must be unit length.
+template <class F>
+void walk_majorant_segments(const Scene& scene, const Ray& ray, double t_min, double t_max,
+                            int inside, F&& f) {
+  if (inside >= 0 && scene.objects[inside].medium < 0) return;  // a solid without a medium
+  // at(): a scene whose octrees were never built fails loudly rather than reading past the end.
+  const MajorantOctree& tree = inside >= 0 ? scene.solid_octrees.at(inside) : scene.field_octree;
+  const double scale = scene.settings.tracking.majorant_scale;
+  MajorantSegment pending{0, 0, Rgb(0.0), Rgb(0.0)};
+  bool has_pending = false;
+  const bool finished =
+      walk_octree(tree, ray, t_min, t_max, [&](const OctreeNode& node, double a, double b) {
+        const Rgb mu_bar = node.mu_bar * scale;
+        if (has_pending && a == pending.t1 && mu_bar == pending.mu_bar &&
+            node.mu_c == pending.mu_c) {
+          pending.t1 = b;
+          return true;
+        }
+        if (has_pending && !f(std::as_const(pending))) return false;
+        pending = {a, b, mu_bar, node.mu_c};
+        has_pending = true;
+        return true;
+      });
+  if (finished && has_pending) f(std::as_const(pending));
+}
 
 // The mixture phase function at a scattering point: value per channel and its sampling.
 Rgb phase_value(const MediumPoint& m, double cos_theta);

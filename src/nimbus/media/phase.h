@@ -13,7 +13,6 @@
 
 namespace nimbus {
 
-
 // p_HG(cos θ) = (1 − g²) / (4π (1 + g² − 2 g cos θ)^{3/2}), |g| < 1; g = 0 gives 1/(4π).
 double hg_phase(double cos_theta, double g);
 

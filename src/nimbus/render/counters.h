@@ -11,9 +11,10 @@ struct Counters {
   uint64_t paths = 0;
   uint64_t surface_rays = 0;  // closest-hit queries
   uint64_t shadow_rays = 0;
-  uint64_t real_collisions = 0;  // scattering or absorption events in media
-  uint64_t scatter_events = 0;   // real scattering events in media
-  TrackingCounters tracking;     // tentative collisions, density lookups, clamped probabilities
+  uint64_t real_collisions = 0;    // scattering or absorption events in media
+  uint64_t scatter_events = 0;     // real scattering events in media
+  uint64_t majorant_segments = 0;  // segments of the majorant walk that estimators tracked over
+  TrackingCounters tracking;       // tentative collisions, density lookups, clamped probabilities
 
   uint64_t null_collisions() const { return tracking.tentative_collisions - real_collisions; }
 
@@ -23,6 +24,7 @@ struct Counters {
     shadow_rays += o.shadow_rays;
     real_collisions += o.real_collisions;
     scatter_events += o.scatter_events;
+    majorant_segments += o.majorant_segments;
     tracking += o.tracking;
     return *this;
   }

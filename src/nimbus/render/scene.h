@@ -10,6 +10,7 @@
 #include "nimbus/frep/tape.h"
 #include "nimbus/math/box.h"
 #include "nimbus/media/medium.h"
+#include "nimbus/media/octree.h"
 #include "nimbus/render/camera.h"
 #include "nimbus/render/light.h"
 #include "nimbus/render/material.h"
@@ -54,7 +55,11 @@ struct Scene {
   std::vector<Light> lights;
   std::vector<Medium> media;
   std::vector<int> field_objects;  // index-matched objects (surface none) holding a medium
-  double scale = 1;                // size of the scene's bounds, for ray offsets
+  // Majorants and minorants (build_majorant_octrees): of the field, and inside each solid
+  // object holding a medium (indexed by object; empty for the others).
+  MajorantOctree field_octree;
+  std::vector<MajorantOctree> solid_octrees;
+  double scale = 1;  // size of the scene's bounds, for ray offsets
 };
 
 struct SurfaceHit {

@@ -1,5 +1,7 @@
 #include "nimbus/render/stats.h"
 
+#include <algorithm>
+
 namespace nimbus {
 
 nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
@@ -27,9 +29,34 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
       {"real_collisions", c.real_collisions},
       {"null_collisions", c.null_collisions()},
       {"scatter_events", c.scatter_events},
+      {"majorant_segments", c.majorant_segments},
       {"mean_scatter_events_per_path", c.paths ? double(c.scatter_events) / c.paths : 0.0},
       {"clamped_probabilities", c.tracking.clamped},
+      {"null_collision_fraction",
+       c.tracking.tentative_collisions
+           ? double(c.null_collisions()) / double(c.tracking.tentative_collisions)
+           : 0.0},
+      {"density_lookups_per_real_collision",
+       c.real_collisions ? double(c.tracking.lookups) / double(c.real_collisions) : 0.0},
+      {"density_lookups_per_sample", samples > 0 ? double(c.tracking.lookups) / samples : 0.0},
   };
+  // All octrees together: the field's and those inside solids.
+  double build_seconds = 0;
+  size_t nodes = 0, bytes = 0;
+  int depth = 0;
+  auto add = [&](const MajorantOctree& t) {
+    build_seconds += t.build_seconds;
+    nodes += t.nodes.size();
+    bytes += t.nodes.empty() ? 0 : t.bytes();
+    depth = std::max(depth, t.depth);
+  };
+  add(scene.field_octree);
+  for (const MajorantOctree& t : scene.solid_octrees) add(t);
+  j["octree"] = {{"build_seconds", build_seconds},
+                 {"nodes", nodes},
+                 {"bytes", bytes},
+                 {"depth_requested", scene.settings.tracking.octree_depth},
+                 {"depth", depth}};
   return j;
 }
 

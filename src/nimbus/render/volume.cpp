@@ -38,20 +38,11 @@ MediumEvent real_event(const Collision& c, const MediumPoint& at, Counters& coun
 MediumEvent sample_collision(const Scene& scene, const Ray& ray, double t_max, int inside,
                              Rgb& beta, int& channel, Rng& rng, Counters& counters) {
   const TrackingSettings& ts = scene.settings.tracking;
-  const MajorantSegments segs = majorant_segments(scene, ray, 0, t_max, inside);
-  if (segs.count == 0) return {};
   const bool delta = ts.mode == Mode::Delta;
-  if (delta && channel < 0) {
-    channel = std::min(2, static_cast<int>(rng.uniform() * 3));
-    const double b = beta[channel];
-    beta = Rgb(0.0);
-    beta[channel] = 3 * b;
-  }
   EventPolicy policy;
   policy.rule = delta                              ? EventRule::Channel
                 : ts.mode == Mode::SpectralHistory ? EventRule::History
                                                    : EventRule::Max;
-  policy.channel = std::max(channel, 0);
   policy.absorption_events = ts.absorption == TrackingSettings::Absorption::Collide;
   // The classic baseline: Woodcock's delta tracking, which clamps where mu_bar does not bound.
   const bool woodcock = delta && policy.absorption_events && !ts.decomposition;
@@ -63,8 +54,17 @@ MediumEvent sample_collision(const Scene& scene, const Ray& ray, double t_max, i
     return as_sample(last);
   };
   Rgb emitted(0.0);
-  for (int i = 0; i < segs.count; ++i) {
-    const MajorantSegment& seg = segs.seg[i];
+  MediumEvent ev;
+  walk_majorant_segments(scene, ray, 0, t_max, inside, [&](const MajorantSegment& seg) {
+    ++counters.majorant_segments;
+    // Delta tracking picks its channel where the path first meets a medium and reweights.
+    if (delta && channel < 0) {
+      channel = std::min(2, static_cast<int>(rng.uniform() * 3));
+      const double b = beta[channel];
+      beta = Rgb(0.0);
+      beta[channel] = 3 * b;
+    }
+    policy.channel = std::max(channel, 0);
     const double mu_bar = delta ? seg.mu_bar[channel] : seg.mu_bar.max();
     Collision c;
     if (woodcock) {
@@ -77,35 +77,31 @@ MediumEvent sample_collision(const Scene& scene, const Ray& ray, double t_max, i
       c = spectral_tracking<3>(lookup, seg.t0, seg.t1, mu_bar, policy, beta, emitted, rng,
                                counters.tracking);
     }
-    if (c.event == CollisionEvent::Escape) continue;
-    MediumEvent ev = real_event(c, last, counters);
-    ev.emitted = emitted;
-    return ev;
-  }
-  MediumEvent ev;
+    if (c.event == CollisionEvent::Escape) return true;
+    ev = real_event(c, last, counters);
+    return false;
+  });
   ev.emitted = emitted;
   return ev;
 }
 
 MediumEvent sample_collision_mis(const Scene& scene, const Ray& ray, double t_max, int inside,
                                  int hero, MisPath<3>& path, Rng& rng, Counters& counters) {
-  const MajorantSegments segs = majorant_segments(scene, ray, 0, t_max, inside);
   MediumPoint last;
   auto lookup = [&](double t) {
     last = medium_at(scene, ray.at(t), inside);
     return as_sample(last);
   };
   Rgb emitted(0.0);
-  for (int i = 0; i < segs.count; ++i) {
-    const MajorantSegment& seg = segs.seg[i];
+  MediumEvent ev;
+  walk_majorant_segments(scene, ray, 0, t_max, inside, [&](const MajorantSegment& seg) {
+    ++counters.majorant_segments;
     const Collision c = hero_tracking<3>(lookup, seg.t0, seg.t1, seg.mu_bar, hero, path, emitted,
                                          rng, counters.tracking);
-    if (c.event == CollisionEvent::Escape) continue;
-    MediumEvent ev = real_event(c, last, counters);
-    ev.emitted = emitted;
-    return ev;
-  }
-  MediumEvent ev;
+    if (c.event == CollisionEvent::Escape) return true;
+    ev = real_event(c, last, counters);
+    return false;
+  });
   ev.emitted = emitted;
   return ev;
 }
@@ -114,13 +110,12 @@ Rgb transmittance(const Scene& scene, const Ray& ray, double t_max, int inside, 
                   Counters& counters) {
   ++counters.shadow_rays;
   if (occluded(scene, ray, t_max)) return Rgb(0.0);
-  const MajorantSegments segs = majorant_segments(scene, ray, 0, t_max, inside);
   auto lookup = [&](double t) { return as_sample(medium_at(scene, ray.at(t), inside)); };
   const bool residual =
       scene.settings.tracking.transmittance == TrackingSettings::Transmittance::ResidualRatio;
   Rgb T(1.0);
-  for (int i = 0; i < segs.count && !T.is_black(); ++i) {
-    const MajorantSegment& seg = segs.seg[i];
+  walk_majorant_segments(scene, ray, 0, t_max, inside, [&](const MajorantSegment& seg) {
+    ++counters.majorant_segments;
     if (residual) {
       // The residual's rate must bound |mu_t − mu_c|; a scaled majorant may fall below mu_c.
       double mu_bar_r = 0;
@@ -131,7 +126,8 @@ Rgb transmittance(const Scene& scene, const Ray& ray, double t_max, int inside, 
     } else {
       T *= ratio_tracking<3>(lookup, seg.t0, seg.t1, seg.mu_bar.max(), rng, counters.tracking);
     }
-  }
+    return !T.is_black();
+  });
   return T;
 }
 
@@ -139,15 +135,15 @@ bool transmittance_mis(const Scene& scene, const Ray& ray, double t_max, int ins
                        MisPath<3>& path, Rng& rng, Counters& counters) {
   ++counters.shadow_rays;
   if (occluded(scene, ray, t_max)) return false;
-  const MajorantSegments segs = majorant_segments(scene, ray, 0, t_max, inside);
   auto lookup = [&](double t) { return as_sample(medium_at(scene, ray.at(t), inside)); };
-  for (int i = 0; i < segs.count; ++i) {
-    const MajorantSegment& seg = segs.seg[i];
-    if (!hero_ratio_tracking<3>(lookup, seg.t0, seg.t1, seg.mu_bar, hero, path, rng,
-                                counters.tracking))
-      return false;
-  }
-  return true;
+  bool reaches = true;
+  walk_majorant_segments(scene, ray, 0, t_max, inside, [&](const MajorantSegment& seg) {
+    ++counters.majorant_segments;
+    reaches = hero_ratio_tracking<3>(lookup, seg.t0, seg.t1, seg.mu_bar, hero, path, rng,
+                                     counters.tracking);
+    return reaches;
+  });
+  return reaches;
 }
 
 }  // namespace nimbus

@@ -4,6 +4,7 @@
 
 #include "nimbus/frep/bounds.h"
 #include "nimbus/media/medium_field.h"
+#include "nimbus/media/octree.h"
 #include "nimbus/scene/load.h"
 
 namespace nimbus {
@@ -100,8 +101,6 @@ Medium compile_medium(const MediumDesc& d) {
       break;
   }
   m.scale = d.density.scale;
-  // Only a constant density has a useful lower bound everywhere inside its object.
-  m.density_min = m.density == Medium::Density::Constant ? m.scale : 0.0;
   CloudParams cp;
   cp.octaves = d.density.octaves;
   cp.frequency = d.density.frequency;
@@ -110,21 +109,6 @@ Medium compile_medium(const MediumDesc& d) {
   cp.edge = d.density.edge;
   m.cloud = make_cloud_density(cp);
   return m;
-}
-
-// An upper bound of the medium's density over the object's bounds, from interval arithmetic on
-// the object's function.
-double density_bound(const Medium& m, const SceneObject& obj) {
-  const Interval F = evaluate(obj.tape, obj.bounds);
-  switch (m.density) {
-    case Medium::Density::Constant:
-      return m.scale;
-    case Medium::Density::Field:
-      return m.scale * std::max(F.hi, 0.0);
-    case Medium::Density::Cloud:
-      return m.scale * cloud_density_range(F.lo, F.hi, m.cloud.params).second;
-  }
-  return 0.0;
 }
 
 }  // namespace
@@ -170,14 +154,8 @@ Scene compile_scene(const SceneDesc& desc) {
     scene.objects.push_back(std::move(obj));
   }
   for (const LightDesc& ld : desc.lights) scene.lights.push_back(compile_light(ld));
-  // Each medium's majorant is the largest bound over the objects that hold it.
-  for (Medium& m : scene.media) m.density_max = 0;
-  for (const SceneObject& obj : scene.objects)
-    if (obj.medium >= 0) {
-      Medium& m = scene.media[obj.medium];
-      m.density_max = std::max(m.density_max, density_bound(m, obj));
-    }
   if (!all.empty()) scene.scale = length(all.extent());
+  build_majorant_octrees(scene);
   return scene;
 }
 

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "nimbus/frep/primitives.h"
+#include "nimbus/media/octree.h"
 
 namespace nimbus {
 namespace {
@@ -163,7 +164,7 @@ class Loader {
     }
     if (auto x = o.optional("octree")) {
       JsonObject t(*x);
-      if (auto y = t.optional("depth")) d.octree.depth = y->integer(between(0, 10));
+      if (auto y = t.optional("depth")) d.octree.depth = y->integer(between(0, kOctreeMaxDepth));
       t.finish();
     }
     o.finish();

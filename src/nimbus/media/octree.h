@@ -1,0 +1,132 @@
+#pragma once
+// The majorant octree (DESIGN.md, "Majorants and minorants are one structure"): an adaptive
+// octree over the media's bounds holding, per node and per channel, a majorant mu_bar and a
+// minorant mu_c of mu_t. Free-path estimators get their rates from a front-to-back walk of the
+// leaves a ray crosses, so tight bounds where the medium is thin mean few null collisions there.
+//
+// Bounds (source "bound") come from interval arithmetic: evaluate(tape, node box) for every
+// object that may hold medium in the node, mapped through its density model and summed. They
+// provably bound mu_t. Source "sample" replaces the leaves' values by the minimum and maximum of
+// mu_t at random points (the paper's preliminary pass): tighter, but they may not bound. Which
+// nodes are empty and where the tree splits always come from the intervals, so a sampled tree
+// never skips a node that may hold medium.
+//
+// A node is split, down to the requested depth, unless it is empty, homogeneous
+// (mu_bar − mu_c <= kOctreeHomogeneous · mu_bar in every channel), or optically thin for the
+// null part (max_c (mu_bar − mu_c) · diagonal <= kOctreeThinNull: a ray crossing it expects at
+// most that many null collisions, which no split can improve much). The tree is built level by
+// level; when the next level would exceed kOctreeMaxNodes, only the nodes with the largest
+// null optical depth (max_c (mu_bar − mu_c) · diagonal) are split, so memory stays bounded at
+// any depth and the tree does not depend on the number of threads. Then splits that do not pay
+// for themselves are undone, bottom up, by a cost model like a BVH's surface area heuristic:
+// a leaf costs a walk step plus kOctreeLookupCost per expected null collision of a ray crossing
+// it, an interior node a step plus its children's costs weighted by the chance a ray crossing
+// the node crosses them.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "nimbus/math/box.h"
+#include "nimbus/math/ray.h"
+#include "nimbus/spectral/spectrum.h"
+
+namespace nimbus {
+
+struct Scene;
+
+inline constexpr int kOctreeMaxDepth = 16;
+inline constexpr double kOctreeHomogeneous = 0.02;
+inline constexpr double kOctreeThinNull = 0.05;
+inline constexpr std::size_t kOctreeMaxNodes = std::size_t{1} << 18;
+// What a density lookup costs in steps of the walk, for deciding which splits pay off.
+inline constexpr double kOctreeLookupCost = 16;
+
+struct OctreeNode {
+  Rgb mu_bar{0.0};  // majorant of mu_t (the majorant scale is applied by the walk)
+  Rgb mu_c{0.0};    // minorant of mu_t
+  // The first of 8 contiguous children, child k in octant (k & 1: upper x, k & 2: upper y,
+  // k & 4: upper z); -1 for a leaf.
+  std::int32_t children = -1;
+  bool empty = true;  // no medium can be in the node
+};
+
+struct MajorantOctree {
+  Box box;  // the root's box; empty when there is no medium
+  // Half the extent of a node at each level; the build and the walk both place children with it,
+  // so they agree on every box to the last bit.
+  std::array<Vec3, kOctreeMaxDepth + 1> half{};
+  std::vector<OctreeNode> nodes;  // breadth first, nodes[0] the root; empty when no medium
+  int depth = 0;                  // deepest level reached
+  double build_seconds = 0;
+  std::size_t bytes() const { return sizeof(MajorantOctree) + nodes.size() * sizeof(OctreeNode); }
+};
+
+// The octree of the media a ray sees from `inside`: -1 for the field of index-matched objects,
+// else the index of a solid object holding a medium (only its medium, over its bounds). Uses
+// scene.settings.tracking (octree_depth, majorant_source, majorant_samples) and seed.
+MajorantOctree build_majorant_octree(const Scene& scene, int inside);
+
+// (Re)builds every octree of the scene: the field's and one per solid object with a medium.
+// Call after the objects, media and tracking settings are final.
+void build_majorant_octrees(Scene& scene);
+
+// Calls leaf(node, a, b) for every non-empty leaf the ray crosses in [t_min, t_max], front to
+// back, with [a, b] the ray's stretch inside it; consecutive stretches share their end points
+// exactly. leaf returns false to stop; then so does the walk.
+template <class Leaf>
+bool walk_octree(const MajorantOctree& tree, const Ray& ray, double t_min, double t_max,
+                 Leaf&& leaf) {
+  if (tree.nodes.empty()) return true;
+  double t0 = t_min, t1 = t_max;
+  if (!clip_ray(tree.box, ray, t0, t1) || !(t1 > t0)) return true;
+  Vec3 inv;
+  for (int k = 0; k < 3; ++k) inv[k] = 1.0 / ray.d[k];
+  struct Item {
+    std::int32_t node;
+    int level;
+    Vec3 center;
+    double t0, t1;
+  };
+  // Every interior node pops once and pushes at most 4 children: 3 per level stay behind.
+  Item stack[3 * kOctreeMaxDepth + 4];
+  int top = 0;
+  stack[top++] = {0, 0, tree.box.center(), t0, t1};
+  while (top > 0) {
+    const Item it = stack[--top];
+    const OctreeNode& node = tree.nodes[it.node];
+    if (node.children < 0) {
+      if (!node.empty && !leaf(node, it.t0, it.t1)) return false;
+      continue;
+    }
+    // The ray crosses the three mid-planes in order; between crossings it is in one child.
+    double cuts[5] = {it.t0, 0, 0, 0, 0};
+    int n = 1;
+    for (int k = 0; k < 3; ++k) {
+      const double t = (it.center[k] - ray.o[k]) * inv[k];
+      if (t > it.t0 && t < it.t1) cuts[n++] = t;
+    }
+    for (int i = 2; i < n; ++i)
+      for (int j = i; j > 1 && cuts[j] < cuts[j - 1]; --j) std::swap(cuts[j], cuts[j - 1]);
+    cuts[n] = it.t1;
+    const Vec3& half = tree.half[it.level + 1];
+    for (int i = n - 1; i >= 0; --i) {
+      const double a = cuts[i], b = cuts[i + 1];
+      if (!(b > a)) continue;
+      const Vec3 p = ray.at(0.5 * (a + b));
+      int octant = 0;
+      Vec3 c = it.center;
+      for (int k = 0; k < 3; ++k) {
+        const bool upper = p[k] >= it.center[k];
+        octant |= upper << k;
+        c[k] += upper ? half[k] : -half[k];
+      }
+      stack[top++] = {node.children + octant, it.level + 1, c, a, b};
+    }
+  }
+  return true;
+}
+
+}  // namespace nimbus

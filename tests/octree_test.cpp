@@ -1,0 +1,312 @@
+// The majorant octree (issue 6): conservative bounds at random points, the ray walk's segments,
+// empty nodes, determinism, the sampling source and the size limits.
+
+#include "nimbus/media/octree.h"
+
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include <vector>
+
+#include "nimbus/frep/bounds.h"
+#include "nimbus/frep/primitives.h"
+#include "nimbus/frep/tape.h"
+#include "nimbus/math/rng.h"
+#include "nimbus/media/medium_field.h"
+#include "nimbus/render/scene.h"
+
+namespace nimbus {
+namespace {
+
+void add_field_object(Scene& scene, const ShapePtr& shape, const Medium& medium) {
+  SceneObject obj;
+  obj.tape = compile(*shape);
+  obj.bounds = compute_bounds(obj.tape).box;
+  obj.surface.type = Surface::Type::None;
+  obj.medium = static_cast<int>(scene.media.size());
+  scene.media.push_back(medium);
+  scene.field_objects.push_back(static_cast<int>(scene.objects.size()));
+  scene.objects.push_back(std::move(obj));
+}
+
+// A cloud, a field-density absorber and a constant-density free form, overlapping, with empty
+// space between them inside the union of their bounds.
+Scene three_media(int depth) {
+  Scene scene;
+  scene.settings.seed = 7;
+  scene.settings.tracking.octree_depth = depth;
+  Medium cloud;
+  cloud.sigma_s = Rgb({4.0, 8.0, 12.0});
+  cloud.density = Medium::Density::Cloud;
+  cloud.cloud = make_cloud_density(CloudParams{});
+  add_field_object(scene, make_shape(QuadricNode{sphere({0, 0, 0}, 1)}), cloud);
+  Medium field;
+  field.sigma_a = Rgb({1.0, 2.0, 3.0});
+  field.density = Medium::Density::Field;
+  field.scale = 2;
+  add_field_object(scene, make_shape(QuadricNode{ellipsoid({0.9, 0.2, 0}, {1, 0.5, 0.7})}), field);
+  Medium constant;
+  constant.sigma_a = Rgb(0.5);
+  constant.sigma_s = Rgb({3.0, 2.0, 1.0});
+  FreeFormNode bumpy{make_shape(QuadricNode{sphere({-1.2, 1.0, 0.3}, 0.6)}),
+                     {{make_shape(QuadricNode{sphere({-0.8, 1.3, 0.3}, 0.4)}), 0.8}}};
+  add_field_object(scene, make_shape(std::move(bumpy)), constant);
+  build_majorant_octrees(scene);
+  return scene;
+}
+
+Vec3 point_in(const Box& box, Rng& rng) {
+  Vec3 p;
+  for (int k = 0; k < 3; ++k) p[k] = box.lo[k] + rng.uniform() * (box.hi[k] - box.lo[k]);
+  return p;
+}
+
+// Calls f(node, level) for the nodes from the root down to the leaf holding p, choosing children
+// as the walk does.
+template <class F>
+void descend(const MajorantOctree& tree, const Vec3& p, F&& f) {
+  Vec3 center = tree.box.center();
+  int index = 0;
+  for (int level = 0;; ++level) {
+    const OctreeNode& node = tree.nodes[index];
+    f(node, level);
+    if (node.children < 0) return;
+    const Vec3& half = tree.half[level + 1];
+    int octant = 0;
+    for (int k = 0; k < 3; ++k) {
+      const bool upper = p[k] >= center[k];
+      octant |= upper << k;
+      center[k] += upper ? half[k] : -half[k];
+    }
+    index = node.children + octant;
+  }
+}
+
+TEST(Octree, ConservativeBoundsContainMuTAtRandomPoints) {
+  const Scene scene = three_media(7);
+  const MajorantOctree& tree = scene.field_octree;
+  ASSERT_GE(tree.depth, 5);
+  Rng rng(1);
+  int inside_medium = 0, checked = 0, deep = 0;
+  for (int i = 0; i < 10000; ++i) {
+    const Vec3 p = point_in(tree.box, rng);
+    const Rgb mu = medium_at(scene, p, -1).mu_t();
+    inside_medium += mu.max() > 0;
+    descend(tree, p, [&](const OctreeNode& node, int level) {
+      ++checked;
+      deep += level >= 5 && node.children < 0;
+      if (node.empty) {
+        EXPECT_EQ(mu.max(), 0.0) << "an empty node holds medium at level " << level;
+        return;
+      }
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_LE(node.mu_c[c], mu[c]) << "level " << level << " channel " << c;
+        EXPECT_GE(node.mu_bar[c], mu[c]) << "level " << level << " channel " << c;
+      }
+    });
+  }
+  EXPECT_GT(inside_medium, 2000);
+  EXPECT_GT(checked, 40000);
+  EXPECT_GT(deep, 1000) << "the tree should refine where the media vary";
+}
+
+struct Walked {
+  std::vector<MajorantSegment> segments;
+  double t_min, t_max;
+};
+
+Walked walk(const Scene& scene, const Ray& ray, double t_min, double t_max) {
+  Walked w{{}, t_min, t_max};
+  walk_majorant_segments(scene, ray, t_min, t_max, -1, [&](const MajorantSegment& s) {
+    w.segments.push_back(s);
+    return true;
+  });
+  return w;
+}
+
+Ray random_ray(const Box& box, Rng& rng) {
+  const Vec3 from = point_in(box, rng) * 1.5, to = point_in(box, rng);
+  return {from, normalize(to - from)};
+}
+
+TEST(Octree, WalkCoversTheMediaInOrderAndBoundsThem) {
+  const Scene scene = three_media(6);
+  Rng rng(2);
+  int gaps = 0, merged_neighbours = 0;
+  for (int r = 0; r < 300; ++r) {
+    const Ray ray = random_ray(scene.field_octree.box, rng);
+    const Walked w = walk(scene, ray, 0.2 * rng.uniform(), 2 + 3 * rng.uniform());
+    for (size_t i = 0; i < w.segments.size(); ++i) {
+      const MajorantSegment& s = w.segments[i];
+      ASSERT_LT(s.t0, s.t1);
+      ASSERT_GE(s.t0, w.t_min);
+      ASSERT_LE(s.t1, w.t_max);
+      if (i > 0) {
+        const MajorantSegment& prev = w.segments[i - 1];
+        ASSERT_LE(prev.t1, s.t0) << "segments out of order";
+        if (prev.t1 == s.t0)
+          EXPECT_FALSE(prev.mu_bar == s.mu_bar && prev.mu_c == s.mu_c) << "not merged";
+        else
+          ++gaps;
+        merged_neighbours += prev.t1 == s.t0;
+      }
+      for (int k = 0; k < 8; ++k) {
+        const double t = s.t0 + rng.uniform() * (s.t1 - s.t0);
+        const Rgb mu = medium_at(scene, ray.at(t), -1).mu_t();
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_LE(s.mu_c[c], mu[c]);
+          EXPECT_GE(s.mu_bar[c], mu[c]);
+        }
+      }
+    }
+    // Wherever there is medium, some segment covers it.
+    for (int k = 0; k < 64; ++k) {
+      const double t = w.t_min + rng.uniform() * (w.t_max - w.t_min);
+      if (medium_at(scene, ray.at(t), -1).mu_t().max() == 0) continue;
+      bool covered = false;
+      for (const MajorantSegment& s : w.segments) covered = covered || (s.t0 <= t && t <= s.t1);
+      EXPECT_TRUE(covered) << "ray " << r << " t " << t;
+    }
+  }
+  EXPECT_GT(gaps, 20) << "empty nodes between the media should leave gaps";
+  EXPECT_GT(merged_neighbours, 100);
+}
+
+TEST(Octree, WalkSkipsEmptyLeavesAndStopsWhenAsked) {
+  const Scene scene = three_media(6);
+  const MajorantOctree& tree = scene.field_octree;
+  int empty_leaves = 0;
+  for (const OctreeNode& n : tree.nodes) empty_leaves += n.children < 0 && n.empty;
+  EXPECT_GT(empty_leaves, 10);
+  Rng rng(3);
+  for (int r = 0; r < 100; ++r) {
+    const Ray ray = random_ray(tree.box, rng);
+    int leaves = 0;
+    walk_octree(tree, ray, 0, 10, [&](const OctreeNode& node, double, double) {
+      EXPECT_FALSE(node.empty);
+      ++leaves;
+      return true;
+    });
+    int calls = 0;
+    const bool finished = walk_octree(tree, ray, 0, 10, [&](const OctreeNode&, double, double) {
+      ++calls;
+      return false;
+    });
+    EXPECT_EQ(calls, leaves > 0 ? 1 : 0);
+    EXPECT_EQ(finished, leaves == 0);
+  }
+}
+
+void expect_same_nodes(const MajorantOctree& a, const MajorantOctree& b) {
+  ASSERT_EQ(a.nodes.size(), b.nodes.size());
+  for (size_t i = 0; i < a.nodes.size(); ++i) {
+    EXPECT_EQ(a.nodes[i].children, b.nodes[i].children) << i;
+    EXPECT_EQ(a.nodes[i].empty, b.nodes[i].empty) << i;
+    EXPECT_TRUE(a.nodes[i].mu_bar == b.nodes[i].mu_bar) << i;
+    EXPECT_TRUE(a.nodes[i].mu_c == b.nodes[i].mu_c) << i;
+  }
+}
+
+TEST(Octree, BuildIsDeterministicAcrossThreadCounts) {
+  Scene scene = three_media(5);
+  tbb::task_arena one(1);
+  const MajorantOctree serial = one.execute([&] { return build_majorant_octree(scene, -1); });
+  expect_same_nodes(scene.field_octree, serial);
+  scene.settings.tracking.majorant_source = TrackingSettings::MajorantSource::Sample;
+  scene.settings.tracking.majorant_samples = 32;
+  const MajorantOctree sampled = build_majorant_octree(scene, -1);
+  expect_same_nodes(sampled, one.execute([&] { return build_majorant_octree(scene, -1); }));
+}
+
+TEST(Octree, SampledBoundsAreFiniteAndOrdered) {
+  Scene scene = three_media(5);
+  scene.settings.tracking.majorant_source = TrackingSettings::MajorantSource::Sample;
+  scene.settings.tracking.majorant_samples = 64;
+  const MajorantOctree sampled = build_majorant_octree(scene, -1);
+  const MajorantOctree& bound = scene.field_octree;
+  // The structure comes from the intervals; only the values are sampled.
+  ASSERT_EQ(sampled.nodes.size(), bound.nodes.size());
+  int tighter = 0;
+  for (size_t i = 0; i < sampled.nodes.size(); ++i) {
+    const OctreeNode& n = sampled.nodes[i];
+    EXPECT_EQ(n.empty, bound.nodes[i].empty);
+    if (n.empty) continue;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_TRUE(std::isfinite(n.mu_bar[c]) && std::isfinite(n.mu_c[c])) << i;
+      EXPECT_LE(0.0, n.mu_c[c]);
+      EXPECT_LE(n.mu_c[c], n.mu_bar[c]);
+      // Samples of mu_t lie within the conservative bounds.
+      EXPECT_LE(n.mu_bar[c], bound.nodes[i].mu_bar[c]);
+      EXPECT_GE(n.mu_c[c], bound.nodes[i].mu_c[c]);
+    }
+    tighter += n.mu_bar.max() < bound.nodes[i].mu_bar.max();
+  }
+  EXPECT_GT(tighter, 10);
+}
+
+TEST(Octree, DepthZeroIsOneNodeAndDeepTreesStayBounded) {
+  const Scene flat = three_media(0);
+  ASSERT_EQ(flat.field_octree.nodes.size(), 1u);
+  EXPECT_EQ(flat.field_octree.depth, 0);
+  // The cloud is heterogeneous throughout (its noise bound is global): the node budget and the
+  // cost model stop it.
+  const Scene deep = three_media(kOctreeMaxDepth);
+  EXPECT_LE(deep.field_octree.nodes.size(), kOctreeMaxNodes);
+  EXPECT_GE(deep.field_octree.depth, 5);
+  EXPECT_EQ(deep.field_octree.bytes(),
+            sizeof(MajorantOctree) + deep.field_octree.nodes.size() * sizeof(OctreeNode));
+}
+
+TEST(Octree, ASmallDenseFeatureIsRefinedToTheFullDepth) {
+  Scene scene;
+  scene.settings.tracking.octree_depth = kOctreeMaxDepth;
+  Medium haze;  // optically thin over the whole box: never worth splitting for
+  haze.sigma_s = Rgb(0.01);
+  add_field_object(scene, box({-1, -1, -1}, {1, 1, 1}), haze);
+  Medium dense;
+  dense.sigma_s = Rgb(1e4);
+  add_field_object(scene, make_shape(QuadricNode{sphere({0.3, 0.3, 0.3}, 2e-4)}), dense);
+  build_majorant_octrees(scene);
+  EXPECT_EQ(scene.field_octree.depth, kOctreeMaxDepth);
+  EXPECT_LT(scene.field_octree.nodes.size(), kOctreeMaxNodes / 4);
+}
+
+TEST(Octree, ConstantMediumInsideASolidIsOneNode) {
+  Scene scene;
+  scene.settings.tracking.octree_depth = 8;
+  Medium m;
+  m.sigma_s = Rgb({1.0, 2.0, 3.0});
+  scene.media.push_back(m);
+  SceneObject obj;
+  obj.tape = compile(*make_shape(QuadricNode{ellipsoid({0, 0, 0}, {1, 0.7, 0.9})}));
+  obj.bounds = compute_bounds(obj.tape).box;
+  obj.surface.type = Surface::Type::Dielectric;
+  obj.medium = 0;
+  scene.objects.push_back(std::move(obj));
+  build_majorant_octrees(scene);
+  EXPECT_TRUE(scene.field_octree.nodes.empty());
+  ASSERT_EQ(scene.solid_octrees.size(), 1u);
+  ASSERT_EQ(scene.solid_octrees[0].nodes.size(), 1u);
+  const OctreeNode& root = scene.solid_octrees[0].nodes[0];
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(root.mu_bar[c], m.sigma_s[c], 1e-9);
+    EXPECT_NEAR(root.mu_c[c], m.sigma_s[c], 1e-9);
+  }
+}
+
+TEST(Octree, MajorantScaleMultipliesTheWalkedMajorants) {
+  Scene scene = three_media(3);
+  const Ray ray{{-3, 0.1, 0.05}, normalize(Vec3{1, 0.02, 0.01})};
+  const Walked plain = walk(scene, ray, 0, 10);
+  scene.settings.tracking.majorant_scale = 0.5;
+  const Walked half = walk(scene, ray, 0, 10);
+  ASSERT_EQ(plain.segments.size(), half.segments.size());
+  ASSERT_FALSE(plain.segments.empty());
+  for (size_t i = 0; i < plain.segments.size(); ++i) {
+    EXPECT_TRUE(half.segments[i].mu_bar == plain.segments[i].mu_bar * 0.5);
+    EXPECT_TRUE(half.segments[i].mu_c == plain.segments[i].mu_c);
+  }
+}
+
+}  // namespace
+}  // namespace nimbus
