@@ -339,10 +339,10 @@ Scene chromatic_cloud(const TrackingSettings& tracking, int spp) {
 
 // One test over all modes, so that the delta reference is rendered once per process.
 TEST(MediaRenderModes, ChromaticCloudAgreesWithDeltaTracking) {
-  const MeanEstimate delta = image_mean(render(chromatic_cloud({}, 1024)).film);
+  const MeanEstimate delta = image_mean(render(chromatic_cloud({}, 512)).film);
   for (const ModeCase& mc : mode_cases()) {
     SCOPED_TRACE(mode_name({mc, 0}));
-    const MeanEstimate m = image_mean(render(chromatic_cloud(tracking_of(mc), 256)).film);
+    const MeanEstimate m = image_mean(render(chromatic_cloud(tracking_of(mc), 128)).film);
     for (int c = 0; c < 3; ++c) {
       const double se = std::hypot(m.standard_error[c], delta.standard_error[c]);
       EXPECT_GT(m.standard_error[c], 0);
