@@ -71,9 +71,10 @@ std::string mode_name(const testing::TestParamInfo<ModeCase>& info) {
 }
 
 // Every mode with absorption events or weights, with and without decomposition; the spectral
-// modes also with majorants scaled by 0.5, which do not bound (delta and spectral MIS clamp
-// there, so they are biased by design); spectral MIS in its own form (absorption events, no
-// decomposition).
+// modes also with majorants scaled by 0.5, which do not bound. Not delta tracking there:
+// Woodcock's clamps (biased by design), and its weighted form, though unbiased, has weights
+// growing like 3^k (tests/spectral_tracking_test.cpp); nor spectral MIS, which clamps. Spectral
+// MIS in its own form (absorption events, no decomposition).
 std::vector<ModeCase> mode_cases() {
   using M = TrackingSettings::Mode;
   using A = TrackingSettings::Absorption;
