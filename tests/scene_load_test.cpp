@@ -423,7 +423,7 @@ TEST(SceneLoad, DefaultsApplyWhereKeysAreOptional) {
   EXPECT_EQ(s.integrator.majorant.source, "bound");
   EXPECT_EQ(s.integrator.majorant.samples, 4096);
   EXPECT_EQ(s.integrator.majorant.scale, 1.0);
-  EXPECT_EQ(s.integrator.octree.depth, 0);
+  EXPECT_EQ(s.integrator.octree.depth, 4);
   EXPECT_TRUE(s.lights.empty());
   ASSERT_EQ(s.media.size(), 1u);
   EXPECT_TRUE(s.media[0].sigma_s.is_black());

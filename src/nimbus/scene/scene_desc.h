@@ -39,7 +39,7 @@ struct IntegratorDesc {
     double scale = 1.0;            // safety factor applied to every majorant
   } majorant;
   struct Octree {
-    int depth = 0;  // 0: one global majorant
+    int depth = 4;  // 0: one global node (the baseline)
   } octree;
 };
 
