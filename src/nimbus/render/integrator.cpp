@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "nimbus/media/medium_field.h"
 #include "nimbus/render/sampling.h"
@@ -34,6 +35,26 @@ int solid_containing(const Scene& scene, const Vec3& p) {
   return -1;
 }
 
+// One light sample for next-event estimation at p, with the scattering function's value there
+// and the shadow ray's origin; none if the light cannot contribute.
+struct LightCandidate {
+  LightSample ls;
+  Rgb f;
+  Vec3 origin;
+};
+
+template <class F>
+std::optional<LightCandidate> light_candidate(const Scene& scene, const Light& light, const Vec3& p,
+                                              const Vec3& n, bool on_surface, F&& f, Rng& rng) {
+  const double u1 = rng.uniform(), u2 = rng.uniform();
+  const auto ls = sample_light(light, p, u1, u2);
+  if (!ls) return std::nullopt;
+  if (on_surface && dot(ls->wi, n) <= 0) return std::nullopt;
+  const Rgb fv = f(ls->wi);
+  if (fv.is_black()) return std::nullopt;
+  return LightCandidate{*ls, fv, on_surface ? offset_origin(scene, p, n, ls->wi) : p};
+}
+
 // Light reaching p along one sample of every light (next-event estimation), times the
 // scattering function `f(wi)` (cosine included for surfaces) and the transmittance through media;
 // MIS with the sampling of f for lights that sampling can hit.
@@ -42,13 +63,11 @@ Rgb direct_light(const Scene& scene, const Vec3& p, const Vec3& n, bool on_surfa
                  F&& f, Pdf&& f_pdf, Rng& rng, Counters& counters) {
   Rgb L(0.0);
   for (const Light& light : scene.lights) {
-    const double u1 = rng.uniform(), u2 = rng.uniform();
-    const auto ls = sample_light(light, p, u1, u2);
-    if (!ls) continue;
-    if (on_surface && dot(ls->wi, n) <= 0) continue;
-    const Rgb fv = f(ls->wi);
-    if (fv.is_black()) continue;
-    const Vec3 o = on_surface ? offset_origin(scene, p, n, ls->wi) : p;
+    const auto cand = light_candidate(scene, light, p, n, on_surface, f, rng);
+    if (!cand) continue;
+    const LightSample* ls = &cand->ls;
+    const Rgb& fv = cand->f;
+    const Vec3& o = cand->origin;
     const Rgb T =
         transmittance(scene, {o, ls->wi}, ls->distance * kShadowShrink, inside, rng, counters);
     if (T.is_black()) continue;
@@ -84,13 +103,11 @@ Rgb direct_light_mis(const Scene& scene, const Vec3& p, const Vec3& n, bool on_s
                      int hero, const Rgb& r_p, F&& f, Pdf&& f_pdf, Rng& rng, Counters& counters) {
   Rgb L(0.0);
   for (const Light& light : scene.lights) {
-    const double u1 = rng.uniform(), u2 = rng.uniform();
-    const auto ls = sample_light(light, p, u1, u2);
-    if (!ls) continue;
-    if (on_surface && dot(ls->wi, n) <= 0) continue;
-    const Rgb fv = f(ls->wi);
-    if (fv.is_black()) continue;
-    const Vec3 o = on_surface ? offset_origin(scene, p, n, ls->wi) : p;
+    const auto cand = light_candidate(scene, light, p, n, on_surface, f, rng);
+    if (!cand) continue;
+    const LightSample* ls = &cand->ls;
+    const Rgb& fv = cand->f;
+    const Vec3& o = cand->origin;
     MisPath<3> shadow;
     if (!transmittance_mis(scene, {o, ls->wi}, ls->distance * kShadowShrink, inside, hero, shadow,
                            rng, counters))

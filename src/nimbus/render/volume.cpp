@@ -18,6 +18,19 @@ MediumSample<3> as_sample(const MediumPoint& m) {
   return s;
 }
 
+// The medium along a ray, keeping the last point looked up: the one at the collision that ends
+// tracking.
+struct RayLookup {
+  const Scene& scene;
+  const Ray& ray;
+  int inside;
+  MediumPoint last;
+  MediumSample<3> operator()(double t) {
+    last = medium_at(scene, ray.at(t), inside);
+    return as_sample(last);
+  }
+};
+
 // Fills in the event of a real collision at t; `at` is the lookup made there.
 MediumEvent real_event(const Collision& c, const MediumPoint& at, Counters& counters) {
   MediumEvent ev;
@@ -47,12 +60,7 @@ MediumEvent sample_collision(const Scene& scene, const Ray& ray, double t_max, i
   // The classic baseline: Woodcock's delta tracking, which clamps where mu_bar does not bound.
   const bool woodcock = delta && policy.absorption_events && !ts.decomposition;
 
-  // The last lookup is the one at the collision that ends tracking: keep it.
-  MediumPoint last;
-  auto lookup = [&](double t) {
-    last = medium_at(scene, ray.at(t), inside);
-    return as_sample(last);
-  };
+  RayLookup lookup{scene, ray, inside, {}};
   Rgb emitted(0.0);
   MediumEvent ev;
   walk_majorant_segments(scene, ray, 0, t_max, inside, [&](const MajorantSegment& seg) {
@@ -69,7 +77,7 @@ MediumEvent sample_collision(const Scene& scene, const Ray& ray, double t_max, i
     Collision c;
     if (woodcock) {
       c = delta_tracking<3>(lookup, seg.t0, seg.t1, mu_bar, channel, rng, counters.tracking);
-      if (c.event == CollisionEvent::Absorb) emitted = beta * as_sample(last).L_e;
+      if (c.event == CollisionEvent::Absorb) emitted = beta * as_sample(lookup.last).L_e;
     } else if (ts.decomposition) {
       c = decomposition_tracking<3>(lookup, seg.t0, seg.t1, seg.mu_c.min(), mu_bar, policy, beta,
                                     emitted, rng, counters.tracking);
@@ -78,7 +86,7 @@ MediumEvent sample_collision(const Scene& scene, const Ray& ray, double t_max, i
                                counters.tracking);
     }
     if (c.event == CollisionEvent::Escape) return true;
-    ev = real_event(c, last, counters);
+    ev = real_event(c, lookup.last, counters);
     return false;
   });
   ev.emitted = emitted;
@@ -87,11 +95,7 @@ MediumEvent sample_collision(const Scene& scene, const Ray& ray, double t_max, i
 
 MediumEvent sample_collision_mis(const Scene& scene, const Ray& ray, double t_max, int inside,
                                  int hero, MisPath<3>& path, Rng& rng, Counters& counters) {
-  MediumPoint last;
-  auto lookup = [&](double t) {
-    last = medium_at(scene, ray.at(t), inside);
-    return as_sample(last);
-  };
+  RayLookup lookup{scene, ray, inside, {}};
   Rgb emitted(0.0);
   MediumEvent ev;
   walk_majorant_segments(scene, ray, 0, t_max, inside, [&](const MajorantSegment& seg) {
@@ -99,7 +103,7 @@ MediumEvent sample_collision_mis(const Scene& scene, const Ray& ray, double t_ma
     const Collision c = hero_tracking<3>(lookup, seg.t0, seg.t1, seg.mu_bar, hero, path, emitted,
                                          rng, counters.tracking);
     if (c.event == CollisionEvent::Escape) return true;
-    ev = real_event(c, last, counters);
+    ev = real_event(c, lookup.last, counters);
     return false;
   });
   ev.emitted = emitted;
