@@ -263,3 +263,38 @@ TEST(DeltaTracking, NonBoundingMajorantClampsAndSaysSo) {
 
 }  // namespace
 }  // namespace nimbus
+
+namespace nimbus {
+namespace {
+
+TEST(TransmittanceRoulette, KeepsTheExpectation) {
+  Rng rng(17);
+  for (double t : {0.5, 0.08, 0.01, -0.03}) {
+    test::MeanVar mv;
+    for (int i = 0; i < 200000; ++i) {
+      Rgb T({t, t / 2, t / 4});
+      transmittance_roulette(T, rng);
+      mv.add(T[0]);
+    }
+    EXPECT_NEAR(mv.mean, t, 4 * mv.std_error() + 1e-15) << t;
+  }
+}
+
+// A dense homogeneous medium (optical depth 12): ratio tracking with roulette stays unbiased and
+// stops long before the segment's end.
+TEST(TransmittanceRoulette, DenseMediumIsUnbiasedAndCheap) {
+  const double mu_t = 8.0, length = 1.5, mu_bar = 10.0;
+  auto lookup = [&](double) { return MediumSample<3>{Rgb(mu_t), Rgb(0.0), Rgb(0.0)}; };
+  Rng rng(29);
+  test::MeanVar T;
+  TrackingCounters counters;
+  const int n = 200000;
+  for (int i = 0; i < n; ++i)
+    T.add(ratio_tracking<3>(lookup, 0.0, length, mu_bar, rng, counters)[0]);
+  EXPECT_NEAR(T.mean, std::exp(-mu_t * length), 4 * T.std_error());
+  // Without roulette every estimate would take mu_bar · length = 15 collisions on average.
+  EXPECT_LT(double(counters.tentative_collisions) / n, 0.5 * mu_bar * length);
+}
+
+}  // namespace
+}  // namespace nimbus

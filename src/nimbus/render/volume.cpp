@@ -125,10 +125,10 @@ Rgb transmittance(const Scene& scene, const Ray& ray, double t_max, int inside, 
       double mu_bar_r = 0;
       for (int c = 0; c < 3; ++c)
         mu_bar_r = std::max(mu_bar_r, std::abs(seg.mu_bar[c] - seg.mu_c[c]));
-      T *= residual_ratio_tracking<3>(lookup, seg.t0, seg.t1, seg.mu_c, mu_bar_r, rng,
-                                      counters.tracking);
+      T = residual_ratio_tracking<3>(lookup, seg.t0, seg.t1, seg.mu_c, mu_bar_r, rng,
+                                     counters.tracking, T);
     } else {
-      T *= ratio_tracking<3>(lookup, seg.t0, seg.t1, seg.mu_bar.max(), rng, counters.tracking);
+      T = ratio_tracking<3>(lookup, seg.t0, seg.t1, seg.mu_bar.max(), rng, counters.tracking, T);
     }
     return !T.is_black();
   });

@@ -9,6 +9,9 @@
 //
 // `lookup(t)` returns the MediumSample<N> at the point x(t) of the ray.
 
+#include <algorithm>
+#include <cmath>
+
 #include "nimbus/math/rng.h"
 #include "nimbus/spectral/spectrum.h"
 #include "nimbus/tracking/counters.h"
@@ -17,13 +20,35 @@
 
 namespace nimbus {
 
+// Below this, a transmittance estimate plays Russian roulette (transmittance_roulette).
+inline constexpr double kRouletteThreshold = 0.1;
+
+// Russian roulette on a transmittance estimate T: once max|T| < kRouletteThreshold, T survives
+// with probability q = max|T| / kRouletteThreshold and is divided by q, else it becomes 0.
+// E[T] is unchanged, and a shadow ray through a dense medium stops after a few more collisions
+// instead of walking to its end. Returns false when T was set to 0.
+template <int N>
+bool transmittance_roulette(Spectrum<N>& T, Rng& rng) {
+  double m = 0;
+  for (int i = 0; i < N; ++i) m = std::max(m, std::abs(T[i]));
+  if (m >= kRouletteThreshold) return true;
+  const double q = m / kRouletteThreshold;
+  if (rng.uniform() < q) {
+    T /= q;
+    return true;
+  }
+  T = Spectrum<N>(0.0);
+  return false;
+}
+
 // Ratio tracking (Cramer 1978; Novák, Selle & Jarosz 2014): T ≈ Π_i (1 − mu_t(t_i)/mu_bar).
-// mu_bar > 0; with mu_bar <= 0 no collision is sampled and 1 is returned, which is exact only
-// where the segment is empty.
+// mu_bar > 0; with mu_bar <= 0 no collision is sampled and T_in is returned, which is exact only
+// where the segment is empty. T_in is the estimate over the ray's earlier segments: the result is
+// T_in times this segment's, with Russian roulette on the running product.
 template <int N, class Lookup>
 Spectrum<N> ratio_tracking(Lookup&& lookup, double t0, double t1, double mu_bar, Rng& rng,
-                           TrackingCounters& counters) {
-  Spectrum<N> T(1.0);
+                           TrackingCounters& counters, const Spectrum<N>& T_in = Spectrum<N>(1.0)) {
+  Spectrum<N> T = T_in;
   if (!(mu_bar > 0)) return T;
   for (double t = t0;;) {
     t += free_flight(mu_bar, rng.uniform());
@@ -32,7 +57,7 @@ Spectrum<N> ratio_tracking(Lookup&& lookup, double t0, double t1, double mu_bar,
     ++counters.lookups;
     const MediumSample<N> m = lookup(t);
     T *= Spectrum<N>(1.0) - m.mu_t() / mu_bar;
-    if (T.is_black()) return T;  // every later factor multiplies zero
+    if (T.is_black() || !transmittance_roulette(T, rng)) return T;
   }
 }
 
@@ -40,10 +65,12 @@ Spectrum<N> ratio_tracking(Lookup&& lookup, double t0, double t1, double mu_bar,
 // on the segment, T = exp(−mu_c (t1 − t0)) · E[Π_i (1 − (mu_t(t_i) − mu_c)/mu_bar_r)], the
 // collisions sampled with rate mu_bar_r, a majorant of |mu_t − mu_c| over all channels. mu_c
 // need not be a minorant. With mu_bar_r <= 0 (no residual) the control term alone is returned.
+// T_in and the roulette as for ratio_tracking.
 template <int N, class Lookup>
 Spectrum<N> residual_ratio_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>& mu_c,
-                                    double mu_bar_r, Rng& rng, TrackingCounters& counters) {
-  Spectrum<N> T = exp(mu_c * (t0 - t1));
+                                    double mu_bar_r, Rng& rng, TrackingCounters& counters,
+                                    const Spectrum<N>& T_in = Spectrum<N>(1.0)) {
+  Spectrum<N> T = T_in * exp(mu_c * (t0 - t1));
   if (!(mu_bar_r > 0)) return T;
   for (double t = t0;;) {
     t += free_flight(mu_bar_r, rng.uniform());
@@ -52,7 +79,7 @@ Spectrum<N> residual_ratio_tracking(Lookup&& lookup, double t0, double t1, const
     ++counters.lookups;
     const MediumSample<N> m = lookup(t);
     T *= Spectrum<N>(1.0) - (m.mu_t() - mu_c) / mu_bar_r;
-    if (T.is_black()) return T;
+    if (T.is_black() || !transmittance_roulette(T, rng)) return T;
   }
 }
 
