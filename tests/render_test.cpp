@@ -9,6 +9,7 @@
 #include "nimbus/frep/primitives.h"
 #include "nimbus/frep/tape.h"
 #include "nimbus/render/renderer.h"
+#include "support/stats.h"
 
 namespace nimbus {
 namespace {
@@ -94,6 +95,73 @@ TEST(Render, ImageIsBitIdenticalForAnyThreadCount) {
     ASSERT_EQ(one.film.sum[p], two.film.sum[p]) << "pixel " << p;
     ASSERT_EQ(one.film.sum_sq[p], two.film.sum_sq[p]) << "pixel " << p;
   }
+}
+
+}  // namespace
+}  // namespace nimbus
+
+namespace nimbus {
+namespace {
+
+// A diffuse floor under a sphere light (radius r, radiance L_s) and nothing else: a uniform
+// sphere above the horizon irradiates like a point of intensity π r² L_s at its centre, so the
+// floor's radiance is albedo · L_s r² cos θ / d². Both path tracers (next-event estimation with
+// MIS against BSDF sampling, and spectral MIS's balance heuristic) must reproduce it.
+void expect_sphere_light_on_floor(TrackingSettings::Mode mode) {
+  const int size = 16;
+  const double r = 0.6, L_s = 5.0, albedo = 0.7;
+  const Vec3 c{0.3, 2.0, -0.2};
+  Scene scene;
+  scene.settings = {size, size, 512, 9, 1000, {}};
+  scene.settings.tracking.mode = mode;
+  // Looking down at the floor from the side, past the light; the view is 1 unit wide.
+  scene.camera = orthographic_camera({3, 3, 3}, {0, 0, 0}, {0, 1, 0}, 1.0, size, size);
+  SceneObject floor;
+  floor.tape = compile(*box({-20, -1, -20}, {20, 0, 20}));
+  floor.bounds = compute_bounds(floor.tape).box;
+  floor.surface.type = Surface::Type::Diffuse;
+  floor.surface.albedo = Rgb(albedo);
+  scene.objects.push_back(floor);
+  Light light;
+  light.type = Light::Type::Sphere;
+  light.center = c;
+  light.radius = r;
+  light.radiance = Rgb(L_s);
+  scene.lights.push_back(light);
+  const RenderResult res = render(scene);
+
+  double chi2 = 0;
+  int dof = 0;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      // Average the closed form over the pixel's footprint on the floor (y = 0).
+      double ref = 0;
+      const int k = 8;
+      for (int i = 0; i < k; ++i)
+        for (int j = 0; j < k; ++j) {
+          const Ray ray = scene.camera.generate(x + (i + 0.5) / k, y + (j + 0.5) / k);
+          const Vec3 p = ray.at(-ray.o.y / ray.d.y);
+          const Vec3 to_c = c - p;
+          const double d2 = dot(to_c, to_c);
+          ref += albedo * L_s * r * r * (to_c.y / std::sqrt(d2)) / d2;
+        }
+      ref /= k * k;
+      const int p = y * size + x;
+      const double var = res.film.variance_of_mean(p)[0];
+      ASSERT_GT(var, 0) << p;
+      const double z = (res.film.mean(p)[0] - ref) / std::sqrt(var);
+      chi2 += z * z;
+      ++dof;
+    }
+  EXPECT_LT(chi2, test::chi_square_critical(dof, 1e-4)) << "over " << dof << " pixels";
+}
+
+TEST(Render, SphereLightOnDiffuseFloorMatchesClosedForm) {
+  expect_sphere_light_on_floor(TrackingSettings::Mode::Delta);
+}
+
+TEST(Render, SphereLightOnDiffuseFloorMatchesClosedFormWithSpectralMis) {
+  expect_sphere_light_on_floor(TrackingSettings::Mode::SpectralMis);
 }
 
 }  // namespace

@@ -62,14 +62,14 @@ template <class F, class Pdf>
 Rgb direct_light(const Scene& scene, const Vec3& p, const Vec3& n, bool on_surface, int inside,
                  F&& f, Pdf&& f_pdf, Rng& rng, Counters& counters) {
   Rgb L(0.0);
-  for (const Light& light : scene.lights) {
-    const auto cand = light_candidate(scene, light, p, n, on_surface, f, rng);
+  for (int i = 0; i < static_cast<int>(scene.lights.size()); ++i) {
+    const auto cand = light_candidate(scene, scene.lights[i], p, n, on_surface, f, rng);
     if (!cand) continue;
     const LightSample* ls = &cand->ls;
     const Rgb& fv = cand->f;
     const Vec3& o = cand->origin;
     const Rgb T =
-        transmittance(scene, {o, ls->wi}, ls->distance * kShadowShrink, inside, rng, counters);
+        transmittance(scene, {o, ls->wi}, ls->distance * kShadowShrink, i, inside, rng, counters);
     if (T.is_black()) continue;
     if (ls->delta)
       L += fv * ls->Li * T;
@@ -102,15 +102,15 @@ template <class F, class Pdf>
 Rgb direct_light_mis(const Scene& scene, const Vec3& p, const Vec3& n, bool on_surface, int inside,
                      int hero, const Rgb& r_p, F&& f, Pdf&& f_pdf, Rng& rng, Counters& counters) {
   Rgb L(0.0);
-  for (const Light& light : scene.lights) {
-    const auto cand = light_candidate(scene, light, p, n, on_surface, f, rng);
+  for (int i = 0; i < static_cast<int>(scene.lights.size()); ++i) {
+    const auto cand = light_candidate(scene, scene.lights[i], p, n, on_surface, f, rng);
     if (!cand) continue;
     const LightSample* ls = &cand->ls;
     const Rgb& fv = cand->f;
     const Vec3& o = cand->origin;
     MisPath<3> shadow;
-    if (!transmittance_mis(scene, {o, ls->wi}, ls->distance * kShadowShrink, inside, hero, shadow,
-                           rng, counters))
+    if (!transmittance_mis(scene, {o, ls->wi}, ls->distance * kShadowShrink, i, inside, hero,
+                           shadow, rng, counters))
       continue;
     if (ls->delta) {
       L += fv * ls->Li * shadow.beta / (r_p * shadow.r_l).average();

@@ -26,15 +26,19 @@ std::optional<SurfaceHit> intersect(const Scene& scene, const Ray& ray, double t
   return best;
 }
 
-bool occluded(const Scene& scene, const Ray& ray, double t_max) {
+bool occluded(const Scene& scene, const Ray& ray, double t_max, int target_light) {
   for (const SceneObject& obj : scene.objects) {
     if (obj.surface.type == Surface::Type::None) continue;
     double t0 = 0, t1 = t_max;
     if (!clip_ray(obj.bounds, ray, t0, t1)) continue;
     if (first_hit(obj.tape, ray, t0, t1)) return true;
   }
-  for (const Light& l : scene.lights)
-    if (l.type == Light::Type::Sphere && intersect_sphere_light(l, ray, 0, t_max)) return true;
+  for (int i = 0; i < static_cast<int>(scene.lights.size()); ++i) {
+    const Light& l = scene.lights[i];
+    if (i != target_light && l.type == Light::Type::Sphere &&
+        intersect_sphere_light(l, ray, 0, t_max))
+      return true;
+  }
   return false;
 }
 

@@ -70,8 +70,10 @@ struct SurfaceHit {
 
 // Closest surface (objects with a surface, and sphere lights) along the ray in (0, t_max).
 std::optional<SurfaceHit> intersect(const Scene& scene, const Ray& ray, double t_max);
-// Whether any surface blocks the ray in (0, t_max); media do not block.
-bool occluded(const Scene& scene, const Ray& ray, double t_max);
+// Whether any surface blocks the ray in (0, t_max); media do not block, nor does the light the
+// shadow ray aims at (`target_light`, an index into lights, or -1), which would otherwise hide
+// itself from a shadow ray whose origin was offset towards it.
+bool occluded(const Scene& scene, const Ray& ray, double t_max, int target_light = -1);
 
 // The outward unit normal of an object at a point on its surface (F decreases outwards).
 Vec3 outward_normal(const SceneObject& object, const Vec3& p);

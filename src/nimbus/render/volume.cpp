@@ -110,10 +110,10 @@ MediumEvent sample_collision_mis(const Scene& scene, const Ray& ray, double t_ma
   return ev;
 }
 
-Rgb transmittance(const Scene& scene, const Ray& ray, double t_max, int inside, Rng& rng,
+Rgb transmittance(const Scene& scene, const Ray& ray, double t_max, int light, int inside, Rng& rng,
                   Counters& counters) {
   ++counters.shadow_rays;
-  if (occluded(scene, ray, t_max)) return Rgb(0.0);
+  if (occluded(scene, ray, t_max, light)) return Rgb(0.0);
   auto lookup = [&](double t) { return as_sample(medium_at(scene, ray.at(t), inside)); };
   const bool residual =
       scene.settings.tracking.transmittance == TrackingSettings::Transmittance::ResidualRatio;
@@ -135,10 +135,10 @@ Rgb transmittance(const Scene& scene, const Ray& ray, double t_max, int inside, 
   return T;
 }
 
-bool transmittance_mis(const Scene& scene, const Ray& ray, double t_max, int inside, int hero,
-                       MisPath<3>& path, Rng& rng, Counters& counters) {
+bool transmittance_mis(const Scene& scene, const Ray& ray, double t_max, int light, int inside,
+                       int hero, MisPath<3>& path, Rng& rng, Counters& counters) {
   ++counters.shadow_rays;
-  if (occluded(scene, ray, t_max)) return false;
+  if (occluded(scene, ray, t_max, light)) return false;
   auto lookup = [&](double t) { return as_sample(medium_at(scene, ray.at(t), inside)); };
   bool reaches = true;
   walk_majorant_segments(scene, ray, 0, t_max, inside, [&](const MajorantSegment& seg) {

@@ -32,13 +32,14 @@ MediumEvent sample_collision_mis(const Scene& scene, const Ray& ray, double t_ma
                                  int hero, MisPath<3>& path, Rng& rng, Counters& counters);
 
 // Transmittance over (0, t_max) by ratio or residual ratio tracking (settings.transmittance),
-// and 0 if a surface blocks the way.
-Rgb transmittance(const Scene& scene, const Ray& ray, double t_max, int inside, Rng& rng,
+// and 0 if a surface blocks the way. `light` is the light the shadow ray aims at (it does not
+// block), or -1.
+Rgb transmittance(const Scene& scene, const Ray& ray, double t_max, int light, int inside, Rng& rng,
                   Counters& counters);
 
 // spectral-mis: the shadow ray's T_ray, r_u and r_l (in `path`, which starts at 1), by hero ratio
 // tracking. False if a surface blocks the way or T_ray became 0.
-bool transmittance_mis(const Scene& scene, const Ray& ray, double t_max, int inside, int hero,
-                       MisPath<3>& path, Rng& rng, Counters& counters);
+bool transmittance_mis(const Scene& scene, const Ray& ray, double t_max, int light, int inside,
+                       int hero, MisPath<3>& path, Rng& rng, Counters& counters);
 
 }  // namespace nimbus
