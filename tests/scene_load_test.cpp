@@ -334,7 +334,7 @@ TEST(SceneLoad, ExampleLoads) {
   EXPECT_EQ(s.camera.from, (Vec3{0, 1, 6}));
   EXPECT_EQ(s.camera.fov, 35);
   EXPECT_EQ(s.integrator.spp, 64);
-  EXPECT_EQ(s.integrator.tracking, "delta");
+  EXPECT_EQ(s.integrator.tracking, "spectral-mis");
 
   ASSERT_EQ(s.lights.size(), 4u);
   EXPECT_EQ(s.lights[0].type, LightDesc::Type::Environment);

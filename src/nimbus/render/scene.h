@@ -23,7 +23,7 @@ struct TrackingSettings {
   enum class Absorption { Collide, Weight };
   enum class Transmittance { Ratio, ResidualRatio };
   enum class MajorantSource { Bound, Sample };
-  Mode mode = Mode::Delta;
+  Mode mode = Mode::Delta;  // scenes built in code; scene files default to spectral-mis
   Absorption absorption = Absorption::Weight;
   bool decomposition = false;
   Transmittance transmittance = Transmittance::Ratio;
