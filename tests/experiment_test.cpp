@@ -200,4 +200,32 @@ TEST_F(Experiment, FiguresQuick) {
   }
 }
 
+// Table 2 / Fig. 7: one row per depth; a deeper octree isolates the cloud's dense core from its
+// thin shell and from empty space, so its majorants are tighter and every depth beyond 0 needs
+// fewer density lookups per sample, the fastest depth included.
+TEST_F(Experiment, OctreeDepthQuick) {
+  ASSERT_EQ(run("octree-depth --quick --no-plot --seed 1"), 0);
+  const Csv csv = read_csv(dir_ / "octree_depth.csv");
+  ASSERT_EQ(csv.columns,
+            (std::vector<std::string>{"depth", "build_seconds", "nodes", "bytes", "depth_reached",
+                                      "render_seconds", "lookups_per_sample", "segments_per_sample",
+                                      "null_fraction", "lookups_per_real_collision",
+                                      "render_time_vs_depth1", "lookups_vs_depth1"}));
+  ASSERT_EQ(csv.rows.size(), 3u);
+  const std::vector<double> depths = {0, 2, 4};
+  for (size_t i = 0; i < csv.rows.size(); ++i) {
+    EXPECT_EQ(num(csv.rows[i], "depth"), depths[i]);
+    EXPECT_EQ(num(csv.rows[i], "depth_reached"), depths[i]);
+  }
+  const double at_depth0 = num(csv.rows[0], "lookups_per_sample");
+  const Row& fastest = *std::min_element(csv.rows.begin(), csv.rows.end(), [](auto& a, auto& b) {
+    return num(a, "render_seconds") < num(b, "render_seconds");
+  });
+  if (num(fastest, "depth") != 0) {
+    EXPECT_LT(num(fastest, "lookups_per_sample"), at_depth0);
+  }
+  EXPECT_LT(num(csv.rows[1], "lookups_per_sample"), 0.5 * at_depth0);
+  EXPECT_LT(num(csv.rows[2], "lookups_per_sample"), num(csv.rows[1], "lookups_per_sample"));
+}
+
 }  // namespace

@@ -1,8 +1,7 @@
 #!/usr/bin/python3
-"""Plots bench/octree_depth's CSV like the paper's Fig. 7: build time, memory and tracking cost
-against octree depth.
+"""Build time, memory and tracking cost against octree depth, like the paper's Fig. 7.
 
-    /usr/bin/python3 tools/plot_octree_depth.py octree_depth.csv docs/images/octree_depth.png
+Usage: plot_octree_depth.py DIR   (reads DIR/octree_depth.csv, writes DIR/octree_depth.png)
 """
 import csv
 import sys
@@ -13,8 +12,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
-def main(csv_path, png_path):
-    with open(csv_path) as f:
+def main(out):
+    with open(f"{out}/octree_depth.csv") as f:
         rows = list(csv.DictReader(f))
     depth = [int(r["depth"]) for r in rows]
 
@@ -45,10 +44,10 @@ def main(csv_path, png_path):
         ax.set_xticks(depth)
         ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(png_path, dpi=110)
+    fig.savefig(f"{out}/octree_depth.png", dpi=110)
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 3:
+    if len(sys.argv) != 2:
         sys.exit(__doc__)
-    main(sys.argv[1], sys.argv[2])
+    main(sys.argv[1])

@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "nimbus/experiments/figures.h"
+#include "nimbus/experiments/octree_depth.h"
 #include "nimbus/experiments/scatter_distance.h"
 #include "nimbus/experiments/segments.h"
 #include "nimbus/experiments/throughput.h"
@@ -24,6 +25,9 @@ const std::vector<Experiment>& experiments() {
       {"segments",
        "Sec. 4: path segments, lookups and equal-time MSE of spectral vs. delta tracking",
        run_segments},
+      {"octree-depth",
+       "Table 2, Fig. 7: octree build time, memory and tracking work against octree depth",
+       run_octree_depth},
   };
   return all;
 }
