@@ -26,6 +26,7 @@ struct ModeCase {
   bool decomposition;
   double majorant_scale;
   int octree_depth;
+  bool sampled_majorant = false;  // the paper's short sampling pass instead of interval bounds
 };
 
 TrackingSettings tracking_of(const ModeCase& c) {
@@ -38,6 +39,10 @@ TrackingSettings tracking_of(const ModeCase& c) {
                                     : TrackingSettings::Transmittance::Ratio;
   t.majorant_scale = c.majorant_scale;
   t.octree_depth = c.octree_depth;
+  if (c.sampled_majorant) {
+    t.majorant_source = TrackingSettings::MajorantSource::Sample;
+    t.majorant_samples = 64;  // few, so that some leaves' majorants miss the maximum
+  }
   return t;
 }
 
@@ -51,7 +56,7 @@ std::string mode_name(const testing::TestParamInfo<ModeCase>& info) {
   return std::string(mode) +
          (c.absorption == TrackingSettings::Absorption::Collide ? "Collide" : "Weight") +
          (c.decomposition ? "Decomposition" : "") + (c.majorant_scale < 1 ? "Unbounded" : "") +
-         "Depth" + std::to_string(c.octree_depth);
+         (c.sampled_majorant ? "Sampled" : "") + "Depth" + std::to_string(c.octree_depth);
 }
 
 // Every mode with absorption events or weights, with and without decomposition; the spectral
@@ -71,6 +76,8 @@ std::vector<ModeCase> mode_cases() {
           if (mode != M::Delta || scale == 1)
             out.push_back({mode, absorption, decomposition, scale, 4});
   out.push_back({M::SpectralMis, A::Collide, false, 1.0, 4});
+  // The paper's method with majorants and minorants from its sampling pass (may not bound).
+  out.push_back({M::SpectralHistory, A::Weight, true, 1.0, 4, true});
   for (int depth : {0, 12}) {
     out.push_back({M::Delta, A::Collide, false, 1.0, depth});
     out.push_back({M::SpectralHistory, A::Weight, true, 1.0, depth});
