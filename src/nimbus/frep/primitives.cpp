@@ -17,8 +17,8 @@ Quadric expand(const Vec3& p, double s, double u, const Vec3& a, const Vec3& l, 
   for (int i = 0; i < 3; ++i) Sp[i] = S[i][0] * p.x + S[i][1] * p.y + S[i][2] * p.z;
   const Vec3 lin = l - 2.0 * Sp;
   const double c = dot(p, Sp) - dot(l, p) + k;
-  return {{S[0][0], S[1][1], S[2][2], 2 * S[0][1], 2 * S[0][2], 2 * S[1][2], lin.x, lin.y, lin.z,
-           c}};
+  return {
+      {S[0][0], S[1][1], S[2][2], 2 * S[0][1], 2 * S[0][2], 2 * S[1][2], lin.x, lin.y, lin.z, c}};
 }
 
 }  // namespace
@@ -62,7 +62,8 @@ ShapePtr box(const Vec3& lo, const Vec3& hi) {
   const Vec3 c = (lo + hi) * 0.5, e = hi - lo;
   CsgNode node{CsgOp::Intersection, {}};
   const Vec3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-  for (int i = 0; i < 3; ++i) node.children.push_back(make_shape(QuadricNode{slab(c, axes[i], e[i])}));
+  for (int i = 0; i < 3; ++i)
+    node.children.push_back(make_shape(QuadricNode{slab(c, axes[i], e[i])}));
   return make_shape(std::move(node));
 }
 

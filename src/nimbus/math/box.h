@@ -23,8 +23,12 @@ struct Box {
   }
 };
 
-constexpr Box unite(const Box& a, const Box& b) { return {min(a.lo, b.lo), max(a.hi, b.hi)}; }
-constexpr Box intersect(const Box& a, const Box& b) { return {max(a.lo, b.lo), min(a.hi, b.hi)}; }
+constexpr Box unite(const Box& a, const Box& b) {
+  return {min(a.lo, b.lo), max(a.hi, b.hi)};
+}
+constexpr Box intersect(const Box& a, const Box& b) {
+  return {max(a.lo, b.lo), min(a.hi, b.hi)};
+}
 
 // Clips [t0, t1] to the part of the ray inside the box; false when nothing is left.
 bool clip_ray(const Box& box, const Ray& ray, double& t0, double& t1);

@@ -29,8 +29,8 @@ struct IntegratorDesc {
   int spp = 16;
   uint64_t seed = 0;
   int max_depth = 1000;
-  std::string tracking = "spectral-mis";     // delta | spectral-max | spectral-history | spectral-mis
-  std::string absorption = "weight";  // weight | collide
+  std::string tracking = "spectral-mis";  // delta | spectral-max | spectral-history | spectral-mis
+  std::string absorption = "weight";      // weight | collide
   bool decomposition = false;
   std::string transmittance = "ratio";  // ratio | residual-ratio
   struct Majorant {

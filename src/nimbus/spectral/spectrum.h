@@ -19,35 +19,45 @@ struct Spectrum {
   constexpr double operator[](int i) const { return v[i]; }
   constexpr double& operator[](int i) { return v[i]; }
 
-#define NIMBUS_SPECTRUM_OP(op)                                             \
-  constexpr Spectrum& operator op##=(const Spectrum& b) {                  \
-    for (int i = 0; i < N; ++i) v[i] op## = b.v[i];                        \
-    return *this;                                                          \
-  }                                                                        \
-  constexpr Spectrum& operator op##=(double s) {                           \
-    for (int i = 0; i < N; ++i) v[i] op## = s;                             \
-    return *this;                                                          \
-  }                                                                        \
-  friend constexpr Spectrum operator op(Spectrum a, const Spectrum& b) {   \
-    return a op## = b;                                                     \
-  }                                                                        \
-  friend constexpr Spectrum operator op(Spectrum a, double s) { return a op## = s; }
+#define NIMBUS_SPECTRUM_OP(op)                                           \
+  constexpr Spectrum& operator op##=(const Spectrum& b) {                \
+    for (int i = 0; i < N; ++i) v[i] op## = b.v[i];                      \
+    return *this;                                                        \
+  }                                                                      \
+  constexpr Spectrum& operator op##=(double s) {                         \
+    for (int i = 0; i < N; ++i) v[i] op## = s;                           \
+    return *this;                                                        \
+  }                                                                      \
+  friend constexpr Spectrum operator op(Spectrum a, const Spectrum& b) { \
+    return a op## = b;                                                   \
+  }                                                                      \
+  friend constexpr Spectrum operator op(Spectrum a, double s) {          \
+    return a op## = s;                                                   \
+  }
   NIMBUS_SPECTRUM_OP(+)
   NIMBUS_SPECTRUM_OP(-)
   NIMBUS_SPECTRUM_OP(*)
   NIMBUS_SPECTRUM_OP(/)
 #undef NIMBUS_SPECTRUM_OP
-  friend constexpr Spectrum operator*(double s, Spectrum a) { return a *= s; }
+  friend constexpr Spectrum operator*(double s, Spectrum a) {
+    return a *= s;
+  }
   friend constexpr bool operator==(const Spectrum&, const Spectrum&) = default;
 
-  constexpr double max() const { return *std::max_element(v.begin(), v.end()); }
-  constexpr double min() const { return *std::min_element(v.begin(), v.end()); }
+  constexpr double max() const {
+    return *std::max_element(v.begin(), v.end());
+  }
+  constexpr double min() const {
+    return *std::min_element(v.begin(), v.end());
+  }
   constexpr double sum() const {
     double s = 0;
     for (double x : v) s += x;
     return s;
   }
-  constexpr double average() const { return sum() / N; }
+  constexpr double average() const {
+    return sum() / N;
+  }
   constexpr bool is_black() const {
     for (double x : v)
       if (x != 0) return false;
