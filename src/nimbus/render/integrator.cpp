@@ -85,6 +85,21 @@ double max_abs(const Rgb& x) {
   return std::max({std::abs(x[0]), std::abs(x[1]), std::abs(x[2])});
 }
 
+// A scattering direction from the mixture phase function at a medium point, with its
+// per-channel weight (phase value / pdf) and pdf.
+struct PhaseSample {
+  Vec3 wi;
+  Rgb weight;
+  double pdf;
+};
+
+PhaseSample draw_phase(const MediumPoint& m, const Vec3& dir, Rng& rng) {
+  const double u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+  PhaseSample ps;
+  ps.wi = sample_phase(m, dir, u0, u1, u2, ps.weight, ps.pdf);
+  return ps;
+}
+
 // Continues the path with probability q = min(1, max|beta / scale|) from depth 3 on.
 bool russian_roulette(Rgb& beta, double scale, int depth, Rng& rng) {
   if (depth < 3) return true;
@@ -157,15 +172,12 @@ Rgb radiance_spectral_mis(const Scene& scene, Ray ray, Rng& rng, Counters& count
                              [&](const Vec3& wi) { return phase_value(m, dot(ray.d, wi)); },
                              [&](const Vec3& wi) { return phase_pdf(m, dot(ray.d, wi)); }, rng,
                              counters);
-      Rgb weight;
-      double pdf;
-      const double u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-      const Vec3 wi = sample_phase(m, ray.d, u0, u1, u2, weight, pdf);
-      path.beta *= weight;
-      path.r_l = path.r_u / pdf;
+      const PhaseSample ps = draw_phase(m, ray.d, rng);
+      path.beta *= ps.weight;
+      path.r_l = path.r_u / ps.pdf;
       prev_p = p;
       specular = false;
-      ray = {p, wi};
+      ray = {p, ps.wi};
       if (!russian_roulette(path.beta, path.r_u.average(), depth, rng)) break;
       continue;
     }
@@ -252,15 +264,12 @@ Rgb radiance(const Scene& scene, Ray ray, Rng& rng, Counters& counters) {
                           [&](const Vec3& wi) { return phase_value(m, dot(ray.d, wi)); },
                           [&](const Vec3& wi) { return phase_pdf(m, dot(ray.d, wi)); }, rng,
                           counters);
-      Rgb weight;
-      double pdf;
-      const double u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
-      const Vec3 wi = sample_phase(m, ray.d, u0, u1, u2, weight, pdf);
-      s.beta *= weight;
-      s.prev_pdf = pdf;
+      const PhaseSample ps = draw_phase(m, ray.d, rng);
+      s.beta *= ps.weight;
+      s.prev_pdf = ps.pdf;
       s.prev_p = p;
       s.specular = false;
-      ray = {p, wi};
+      ray = {p, ps.wi};
       if (!russian_roulette(s.beta, 1.0, depth, rng)) break;
       continue;
     }
