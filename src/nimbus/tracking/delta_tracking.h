@@ -29,24 +29,24 @@ struct Collision {
 template <int N, class Lookup>
 Collision delta_tracking(Lookup&& lookup, double t0, double t1, double mu_bar, int channel,
                          Rng& rng, TrackingCounters& counters) {
-  if (!(mu_bar > 0)) return {CollisionEvent::Escape, t1};
-  for (double t = t0;;) {
-    t += free_flight(mu_bar, rng.uniform());
-    if (t >= t1) return {CollisionEvent::Escape, t1};
-    ++counters.tentative_collisions;
-    ++counters.lookups;
-    const MediumSample<N> m = lookup(t);
-    const double mu_a = m.mu_a[channel], mu_s = m.mu_s[channel];
-    double P_a = mu_a / mu_bar, P_s = mu_s / mu_bar;
-    if (P_a + P_s > 1) {
-      ++counters.clamped;
-      P_a = mu_a / (mu_a + mu_s);
-      P_s = 1 - P_a;
-    }
-    const double u = rng.uniform();
-    if (u < P_a) return {CollisionEvent::Absorb, t};
-    if (u < P_a + P_s) return {CollisionEvent::Scatter, t};
-  }
+  Collision c{CollisionEvent::Escape, t1};
+  track_tentative_collisions(lookup, t0, t1, mu_bar, rng, counters,
+                             [&](double t, const MediumSample<N>& m) {
+                               const double mu_a = m.mu_a[channel], mu_s = m.mu_s[channel];
+                               double P_a = mu_a / mu_bar, P_s = mu_s / mu_bar;
+                               if (P_a + P_s > 1) {
+                                 ++counters.clamped;
+                                 P_a = mu_a / (mu_a + mu_s);
+                                 P_s = 1 - P_a;
+                               }
+                               const double u = rng.uniform();
+                               if (u < P_a)
+                                 c = {CollisionEvent::Absorb, t};
+                               else if (u < P_a + P_s)
+                                 c = {CollisionEvent::Scatter, t};
+                               return c.event == CollisionEvent::Escape;
+                             });
+  return c;
 }
 
 }  // namespace nimbus

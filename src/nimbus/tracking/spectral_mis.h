@@ -42,61 +42,70 @@ Spectrum<N> clamp_zero(const Spectrum<N>& s) {
   return r;
 }
 
+// The free flight that passes the segment's end, over distance d: every path pdf is rescaled by
+// the majorant transmittance relative to the hero channel's.
+template <int N>
+void rescale_to_segment_end(MisPath<N>& path, const Spectrum<N>& mu_maj, int h, double d) {
+  const Spectrum<N> T_maj = exp(mu_maj * -d);
+  path.beta *= T_maj / T_maj[h];
+  path.r_u *= T_maj / T_maj[h];
+  path.r_l *= T_maj / T_maj[h];
+}
+
 // Tracks [t0, t1] with hero channel h until a real collision or the segment's end; updates the
 // path and adds the weighted emission to `emitted`.
 template <int N, class Lookup>
 Collision hero_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>& mu_maj, int h,
                         MisPath<N>& path, Spectrum<N>& emitted, Rng& rng,
                         TrackingCounters& counters) {
-  for (double t = t0;;) {
-    const double dt = mu_maj[h] > 0 ? free_flight(mu_maj[h], rng.uniform()) : t1 - t;
-    if (t + dt >= t1) {
-      const Spectrum<N> T_maj = exp(mu_maj * (t - t1));
-      path.beta *= T_maj / T_maj[h];
-      path.r_u *= T_maj / T_maj[h];
-      path.r_l *= T_maj / T_maj[h];
-      return {CollisionEvent::Escape, t1};
-    }
-    t += dt;
-    ++counters.tentative_collisions;
-    ++counters.lookups;
-    const MediumSample<N> m = lookup(t);
-    const Spectrum<N> T_maj = exp(mu_maj * -dt);
-    const Spectrum<N> mu_a_Le = m.mu_a * m.L_e;
-    if (!mu_a_Le.is_black()) {
-      const double pdf = T_maj[h] * mu_maj[h];
-      const Spectrum<N> r_e = path.r_u * mu_maj * T_maj / pdf;
-      if (r_e.average() > 0) emitted += path.beta * T_maj / pdf * mu_a_Le / r_e.average();
-    }
-    double P_a = m.mu_a[h] / mu_maj[h], P_s = m.mu_s[h] / mu_maj[h];
-    if (P_a + P_s > 1) {
-      ++counters.clamped;
-      P_a /= P_a + P_s;
-      P_s = 1 - P_a;
-    }
-    const double u = rng.uniform();
-    if (u < P_a) {
-      path.beta = Spectrum<N>(0.0);
-      return {CollisionEvent::Absorb, t};
-    }
-    if (u < P_a + P_s) {
-      const double pdf = T_maj[h] * m.mu_s[h];
-      path.beta *= T_maj * m.mu_s / pdf;
-      path.r_u *= T_maj * m.mu_s / pdf;
-      return {CollisionEvent::Scatter, t};
-    }
-    const Spectrum<N> mu_n = clamp_zero(mu_maj - m.mu_t());
-    const double pdf = T_maj[h] * mu_n[h];
-    if (pdf > 0) {
-      path.beta *= T_maj * mu_n / pdf;
-      path.r_u *= T_maj * mu_n / pdf;
-      path.r_l *= T_maj * mu_maj / pdf;
-    }
-    if (!(pdf > 0) || path.beta.is_black() || path.r_u.is_black()) {
-      path.beta = Spectrum<N>(0.0);
-      return {CollisionEvent::Absorb, t};
-    }
-  }
+  Collision c{CollisionEvent::Escape, t1};
+  double t_prev = t0;  // the last tentative collision
+  const bool escaped = track_tentative_collisions(
+      lookup, t0, t1, mu_maj[h], rng, counters, [&](double t, const MediumSample<N>& m) {
+        const double dt = t - t_prev;
+        t_prev = t;
+        const Spectrum<N> T_maj = exp(mu_maj * -dt);
+        const Spectrum<N> mu_a_Le = m.mu_a * m.L_e;
+        if (!mu_a_Le.is_black()) {
+          const double pdf = T_maj[h] * mu_maj[h];
+          const Spectrum<N> r_e = path.r_u * mu_maj * T_maj / pdf;
+          if (r_e.average() > 0) emitted += path.beta * T_maj / pdf * mu_a_Le / r_e.average();
+        }
+        double P_a = m.mu_a[h] / mu_maj[h], P_s = m.mu_s[h] / mu_maj[h];
+        if (P_a + P_s > 1) {
+          ++counters.clamped;
+          P_a /= P_a + P_s;
+          P_s = 1 - P_a;
+        }
+        const double u = rng.uniform();
+        if (u < P_a) {
+          path.beta = Spectrum<N>(0.0);
+          c = {CollisionEvent::Absorb, t};
+          return false;
+        }
+        if (u < P_a + P_s) {
+          const double pdf = T_maj[h] * m.mu_s[h];
+          path.beta *= T_maj * m.mu_s / pdf;
+          path.r_u *= T_maj * m.mu_s / pdf;
+          c = {CollisionEvent::Scatter, t};
+          return false;
+        }
+        const Spectrum<N> mu_n = clamp_zero(mu_maj - m.mu_t());
+        const double pdf = T_maj[h] * mu_n[h];
+        if (pdf > 0) {
+          path.beta *= T_maj * mu_n / pdf;
+          path.r_u *= T_maj * mu_n / pdf;
+          path.r_l *= T_maj * mu_maj / pdf;
+        }
+        if (!(pdf > 0) || path.beta.is_black() || path.r_u.is_black()) {
+          path.beta = Spectrum<N>(0.0);
+          c = {CollisionEvent::Absorb, t};
+          return false;
+        }
+        return true;
+      });
+  if (escaped) rescale_to_segment_end(path, mu_maj, h, t1 - t_prev);
+  return c;
 }
 
 // Ratio tracking of a shadow segment for spectral MIS: T_ray (in `path.beta`) and the light and
@@ -108,35 +117,29 @@ Collision hero_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>
 template <int N, class Lookup>
 bool hero_ratio_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>& mu_maj, int h,
                          MisPath<N>& path, Rng& rng, TrackingCounters& counters) {
-  for (double t = t0;;) {
-    const double dt = mu_maj[h] > 0 ? free_flight(mu_maj[h], rng.uniform()) : t1 - t;
-    if (t + dt >= t1) {
-      const Spectrum<N> T_maj = exp(mu_maj * (t - t1));
-      path.beta *= T_maj / T_maj[h];
-      path.r_u *= T_maj / T_maj[h];
-      path.r_l *= T_maj / T_maj[h];
-      return true;
-    }
-    t += dt;
-    ++counters.tentative_collisions;
-    ++counters.lookups;
-    const MediumSample<N> m = lookup(t);
-    const Spectrum<N> T_maj = exp(mu_maj * -dt);
-    const Spectrum<N> mu_n = clamp_zero(mu_maj - m.mu_t());
-    if (m.mu_t()[h] > mu_maj[h]) ++counters.clamped;
-    const double pdf = T_maj[h] * mu_maj[h];
-    path.beta *= T_maj * mu_n / pdf;
-    path.r_l *= T_maj * mu_maj / pdf;
-    path.r_u *= T_maj * mu_n / pdf;
-    const Spectrum<N> T = path.beta / (path.r_u + path.r_l).average();
-    if (T.max() < 0.05) {
-      if (rng.uniform() < 0.75)
-        path.beta = Spectrum<N>(0.0);
-      else
-        path.beta /= 0.25;
-    }
-    if (path.beta.is_black()) return false;
-  }
+  double t_prev = t0;  // the last tentative collision
+  const bool reached = track_tentative_collisions(
+      lookup, t0, t1, mu_maj[h], rng, counters, [&](double t, const MediumSample<N>& m) {
+        const double dt = t - t_prev;
+        t_prev = t;
+        const Spectrum<N> T_maj = exp(mu_maj * -dt);
+        const Spectrum<N> mu_n = clamp_zero(mu_maj - m.mu_t());
+        if (m.mu_t()[h] > mu_maj[h]) ++counters.clamped;
+        const double pdf = T_maj[h] * mu_maj[h];
+        path.beta *= T_maj * mu_n / pdf;
+        path.r_l *= T_maj * mu_maj / pdf;
+        path.r_u *= T_maj * mu_n / pdf;
+        const Spectrum<N> T = path.beta / (path.r_u + path.r_l).average();
+        if (T.max() < 0.05) {
+          if (rng.uniform() < 0.75)
+            path.beta = Spectrum<N>(0.0);
+          else
+            path.beta /= 0.25;
+        }
+        return !path.beta.is_black();
+      });
+  if (reached) rescale_to_segment_end(path, mu_maj, h, t1 - t_prev);
+  return reached;
 }
 
 }  // namespace nimbus

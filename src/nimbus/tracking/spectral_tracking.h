@@ -19,23 +19,23 @@ template <int N, class Lookup>
 Collision spectral_tracking(Lookup&& lookup, double t0, double t1, double mu_bar,
                             const EventPolicy& policy, Spectrum<N>& w, Spectrum<N>& emitted,
                             Rng& rng, TrackingCounters& counters) {
-  if (!(mu_bar > 0)) return {CollisionEvent::Escape, t1};
-  for (double t = t0;;) {
-    t += free_flight(mu_bar, rng.uniform());
-    if (t >= t1) return {CollisionEvent::Escape, t1};
-    ++counters.tentative_collisions;
-    ++counters.lookups;
-    const MediumSample<N> m = lookup(t);
-    const Spectrum<N> mu_n = Spectrum<N>(mu_bar) - m.mu_t();  // eq. 5: mu_n = mu_bar − mu_t
-    switch (weighted_collision(m, mu_n, mu_bar, policy, w, emitted, rng.uniform())) {
-      case TentativeEvent::Absorb:
-        return {CollisionEvent::Absorb, t};
-      case TentativeEvent::Scatter:
-        return {CollisionEvent::Scatter, t};
-      case TentativeEvent::Null:
-        break;
-    }
-  }
+  Collision c{CollisionEvent::Escape, t1};
+  track_tentative_collisions(
+      lookup, t0, t1, mu_bar, rng, counters, [&](double t, const MediumSample<N>& m) {
+        const Spectrum<N> mu_n = Spectrum<N>(mu_bar) - m.mu_t();  // eq. 5
+        switch (weighted_collision(m, mu_n, mu_bar, policy, w, emitted, rng.uniform())) {
+          case TentativeEvent::Absorb:
+            c = {CollisionEvent::Absorb, t};
+            return false;
+          case TentativeEvent::Scatter:
+            c = {CollisionEvent::Scatter, t};
+            return false;
+          case TentativeEvent::Null:
+            break;
+        }
+        return true;
+      });
+  return c;
 }
 
 }  // namespace nimbus

@@ -49,16 +49,12 @@ template <int N, class Lookup>
 Spectrum<N> ratio_tracking(Lookup&& lookup, double t0, double t1, double mu_bar, Rng& rng,
                            TrackingCounters& counters, const Spectrum<N>& T_in = Spectrum<N>(1.0)) {
   Spectrum<N> T = T_in;
-  if (!(mu_bar > 0)) return T;
-  for (double t = t0;;) {
-    t += free_flight(mu_bar, rng.uniform());
-    if (t >= t1) return T;
-    ++counters.tentative_collisions;
-    ++counters.lookups;
-    const MediumSample<N> m = lookup(t);
-    T *= Spectrum<N>(1.0) - m.mu_t() / mu_bar;
-    if (T.is_black() || !transmittance_roulette(T, rng)) return T;
-  }
+  track_tentative_collisions(lookup, t0, t1, mu_bar, rng, counters,
+                             [&](double, const MediumSample<N>& m) {
+                               T *= Spectrum<N>(1.0) - m.mu_t() / mu_bar;
+                               return !T.is_black() && transmittance_roulette(T, rng);
+                             });
+  return T;
 }
 
 // Residual ratio tracking (Novák, Selle & Jarosz 2014): with a control extinction mu_c, constant
@@ -71,16 +67,12 @@ Spectrum<N> residual_ratio_tracking(Lookup&& lookup, double t0, double t1, const
                                     double mu_bar_r, Rng& rng, TrackingCounters& counters,
                                     const Spectrum<N>& T_in = Spectrum<N>(1.0)) {
   Spectrum<N> T = T_in * exp(mu_c * (t0 - t1));
-  if (!(mu_bar_r > 0)) return T;
-  for (double t = t0;;) {
-    t += free_flight(mu_bar_r, rng.uniform());
-    if (t >= t1) return T;
-    ++counters.tentative_collisions;
-    ++counters.lookups;
-    const MediumSample<N> m = lookup(t);
-    T *= Spectrum<N>(1.0) - (m.mu_t() - mu_c) / mu_bar_r;
-    if (T.is_black() || !transmittance_roulette(T, rng)) return T;
-  }
+  track_tentative_collisions(lookup, t0, t1, mu_bar_r, rng, counters,
+                             [&](double, const MediumSample<N>& m) {
+                               T *= Spectrum<N>(1.0) - (m.mu_t() - mu_c) / mu_bar_r;
+                               return !T.is_black() && transmittance_roulette(T, rng);
+                             });
+  return T;
 }
 
 }  // namespace nimbus
