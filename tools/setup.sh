@@ -5,7 +5,7 @@ packages=(
   build-essential cmake pkg-config
   libtbb-dev libopenexr-dev libpng-dev nlohmann-json3-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3-numpy python3-matplotlib
+  colord-data python3-numpy python3-matplotlib
 )
 missing=()
 for p in "${packages[@]}"; do
