@@ -200,6 +200,28 @@ TEST_F(Cli, RendersDefaultOutputsAndStats) {
   EXPECT_GT(s["octree"]["bytes"].get<long>(), 0);
   EXPECT_GE(s["octree"]["build_seconds"].get<double>(), 0);
   EXPECT_GE(s["octree"]["depth"].get<int>(), 0);
+  EXPECT_EQ(s["spectrum"]["mode"], "rgb");
+  EXPECT_EQ(s["spectrum"]["channels"], 3);
+}
+
+TEST_F(Cli, RendersInSpectralModeFromTheCommandLine) {
+  write("scene.json", good_scene().dump());
+  const Outcome r = run(
+      "render scene.json --stats stats.json --set film.width=8 --spp 2 --set spectrum.mode=spectral "
+      "--set spectrum.wavelengths=6 -o s.exr --quiet");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "s.exr"));
+  std::ifstream f(dir_ / "stats.json");
+  const nlohmann::json s = nlohmann::json::parse(f);
+  EXPECT_EQ(s["spectrum"]["mode"], "spectral");
+  EXPECT_EQ(s["spectrum"]["channels"], 6);
+  for (int c = 0; c < 3; ++c) EXPECT_GT(s["image_mean"][c].get<double>(), 0);
+  // A wavelength count out of range is a scene error: exit 2, one line, no output.
+  const Outcome bad = run("render scene.json --set spectrum.mode=spectral "
+                          "--set spectrum.wavelengths=32 -o bad.exr");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("/spectrum/wavelengths: must be in [4, 16]"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir_ / "bad.exr"));
 }
 
 TEST_F(Cli, OutputIsTheSameForOneAndTwoThreads) {

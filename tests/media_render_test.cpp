@@ -112,7 +112,7 @@ TEST_P(MediaRender, EmittingFieldAbsorberMatchesClosedForm) {
   Scene scene;
   // 1024 spp: with fewer, the per-pixel sample variances of the weighted trackers' heavy-tailed
   // estimates are too noisy for the chi-square of z-scores to hold its nominal level.
-  scene.settings = {size, size, 1024, 11, 100, tracking()};
+  scene.settings = {size, size, 1024, 11, 100, tracking(), {}};
   const double view = 2.2;
   scene.camera = orthographic_camera({0, 0, 4}, {0, 0, 0}, {0, 1, 0}, view, size, size);
   scene.lights.push_back(test::environment(1.0));
@@ -198,7 +198,7 @@ void expect_white_furnace(Scene& scene) {
 Scene furnace_scene(Medium medium, Surface::Type surface, const ShapePtr& shape,
                     const TrackingSettings& tracking) {
   Scene scene;
-  scene.settings = {12, 12, 64, 5, 100000, tracking};
+  scene.settings = {12, 12, 64, 5, 100000, tracking, {}};
   scene.camera = perspective_camera({0, 0.3, 3.5}, {0, 0, 0}, {0, 1, 0}, 40, 12, 12);
   medium.sigma_a = Rgb(0.0);
   scene.media.push_back(medium);
@@ -263,14 +263,14 @@ void expect_chandrasekhar(double theta0_deg, double theta_deg, const Rgb& albedo
   const double R = 1000;
   const double mu0 = std::cos(theta0_deg * kPi / 180), mu = std::cos(theta_deg * kPi / 180);
   Scene scene;
-  scene.settings = {6, 6, 2048, 3, 100000, tracking};
+  scene.settings = {6, 6, 2048, 3, 100000, tracking, {}};
   const Vec3 view_dir{std::sin(theta_deg * kPi / 180), -mu, 0};
   scene.camera =
       orthographic_camera(Vec3{0, 0, 0} - view_dir * 5.0, {0, 0, 0}, {0, 0, 1}, 0.5, 6, 6);
   Light sun;
   sun.type = Light::Type::Directional;
   sun.direction = normalize(Vec3{0, -mu0, -std::sqrt(1 - mu0 * mu0)});
-  sun.irradiance = Rgb(2.0);
+  sun.emission = Rgb(2.0);
   scene.lights.push_back(sun);
   Medium m;
   m.sigma_s = albedo;
@@ -308,12 +308,12 @@ TEST_P(MediaRender, ChandrasekharHalfSpaceGrazingIncidence) {
 // and a dim sky: no closed form, but every mode must render the same expected image.
 Scene chromatic_cloud(const TrackingSettings& tracking, int spp) {
   Scene scene;
-  scene.settings = {8, 8, spp, 21, 1000, tracking};
+  scene.settings = {8, 8, spp, 21, 1000, tracking, {}};
   scene.camera = perspective_camera({0, 0.5, 3.2}, {0, 0, 0}, {0, 1, 0}, 45, 8, 8);
   Light sun;
   sun.type = Light::Type::Directional;
   sun.direction = normalize(Vec3{-0.4, -1, -0.3});
-  sun.irradiance = Rgb(3.0);
+  sun.emission = Rgb(3.0);
   scene.lights.push_back(sun);
   scene.lights.push_back(test::environment(0.3));
   Medium cloud;

@@ -55,13 +55,30 @@ Scene three_media(int depth) {
   return scene;
 }
 
+// mu_t at p in rgb mode.
+Rgb mu_t_at(const Scene& scene, const Vec3& p) {
+  PathSpectra<3> ps;
+  prepare_path_spectra(ps, scene, 0.0);
+  return medium_at(scene, ps, p, -1).mu_t();
+}
+
+// A node's majorant and minorant in rgb mode.
+Rgb node_mu_bar(const MajorantOctree& tree, size_t i) {
+  const double* b = tree.mu_bar(i);
+  return Rgb({b[0], b[1], b[2]});
+}
+Rgb node_mu_c(const MajorantOctree& tree, size_t i) {
+  const double* b = tree.mu_c(i);
+  return Rgb({b[0], b[1], b[2]});
+}
+
 Vec3 point_in(const Box& box, Rng& rng) {
   Vec3 p;
   for (int k = 0; k < 3; ++k) p[k] = box.lo[k] + rng.uniform() * (box.hi[k] - box.lo[k]);
   return p;
 }
 
-// Calls f(node, level) for the nodes from the root down to the leaf holding p, choosing children
+// Calls f(node index, level) for the nodes from the root down to the leaf holding p, choosing children
 // as the walk does.
 template <class F>
 void descend(const MajorantOctree& tree, const Vec3& p, F&& f) {
@@ -69,7 +86,7 @@ void descend(const MajorantOctree& tree, const Vec3& p, F&& f) {
   int index = 0;
   for (int level = 0;; ++level) {
     const OctreeNode& node = tree.nodes[index];
-    f(node, level);
+    f(index, level);
     if (node.children < 0) return;
     const Vec3& half = tree.half[level + 1];
     int octant = 0;
@@ -90,9 +107,10 @@ TEST(Octree, ConservativeBoundsContainMuTAtRandomPoints) {
   int inside_medium = 0, checked = 0, deep = 0;
   for (int i = 0; i < 10000; ++i) {
     const Vec3 p = point_in(tree.box, rng);
-    const Rgb mu = medium_at(scene, p, -1).mu_t();
+    const Rgb mu = mu_t_at(scene, p);
     inside_medium += mu.max() > 0;
-    descend(tree, p, [&](const OctreeNode& node, int level) {
+    descend(tree, p, [&](int index, int level) {
+      const OctreeNode& node = tree.nodes[index];
       ++checked;
       deep += level >= 5 && node.children < 0;
       if (node.empty) {
@@ -100,8 +118,8 @@ TEST(Octree, ConservativeBoundsContainMuTAtRandomPoints) {
         return;
       }
       for (int c = 0; c < 3; ++c) {
-        EXPECT_LE(node.mu_c[c], mu[c]) << "level " << level << " channel " << c;
-        EXPECT_GE(node.mu_bar[c], mu[c]) << "level " << level << " channel " << c;
+        EXPECT_LE(node_mu_c(tree, index)[c], mu[c]) << "level " << level << " channel " << c;
+        EXPECT_GE(node_mu_bar(tree, index)[c], mu[c]) << "level " << level << " channel " << c;
       }
     });
   }
@@ -111,13 +129,15 @@ TEST(Octree, ConservativeBoundsContainMuTAtRandomPoints) {
 }
 
 struct Walked {
-  std::vector<MajorantSegment> segments;
+  std::vector<MajorantSegment<3>> segments;
   double t_min, t_max;
 };
 
 Walked walk(const Scene& scene, const Ray& ray, double t_min, double t_max) {
   Walked w{{}, t_min, t_max};
-  walk_majorant_segments(scene, ray, t_min, t_max, -1, [&](const MajorantSegment& s) {
+  PathSpectra<3> ps;
+  prepare_path_spectra(ps, scene, 0.0);
+  walk_majorant_segments(scene, ps.ch, ray, t_min, t_max, -1, [&](const MajorantSegment<3>& s) {
     w.segments.push_back(s);
     return true;
   });
@@ -137,12 +157,12 @@ TEST(Octree, WalkCoversTheMediaInOrderAndBoundsThem) {
     const Ray ray = random_ray(scene.field_octree.box, rng);
     const Walked w = walk(scene, ray, 0.2 * rng.uniform(), 2 + 3 * rng.uniform());
     for (size_t i = 0; i < w.segments.size(); ++i) {
-      const MajorantSegment& s = w.segments[i];
+      const MajorantSegment<3>& s = w.segments[i];
       ASSERT_LT(s.t0, s.t1);
       ASSERT_GE(s.t0, w.t_min);
       ASSERT_LE(s.t1, w.t_max);
       if (i > 0) {
-        const MajorantSegment& prev = w.segments[i - 1];
+        const MajorantSegment<3>& prev = w.segments[i - 1];
         ASSERT_LE(prev.t1, s.t0) << "segments out of order";
         if (prev.t1 == s.t0)
           EXPECT_FALSE(prev.mu_bar == s.mu_bar && prev.mu_c == s.mu_c) << "not merged";
@@ -152,7 +172,7 @@ TEST(Octree, WalkCoversTheMediaInOrderAndBoundsThem) {
       }
       for (int k = 0; k < 8; ++k) {
         const double t = s.t0 + rng.uniform() * (s.t1 - s.t0);
-        const Rgb mu = medium_at(scene, ray.at(t), -1).mu_t();
+        const Rgb mu = mu_t_at(scene, ray.at(t));
         for (int c = 0; c < 3; ++c) {
           EXPECT_LE(s.mu_c[c], mu[c]);
           EXPECT_GE(s.mu_bar[c], mu[c]);
@@ -162,9 +182,9 @@ TEST(Octree, WalkCoversTheMediaInOrderAndBoundsThem) {
     // Wherever there is medium, some segment covers it.
     for (int k = 0; k < 64; ++k) {
       const double t = w.t_min + rng.uniform() * (w.t_max - w.t_min);
-      if (medium_at(scene, ray.at(t), -1).mu_t().max() == 0) continue;
+      if (mu_t_at(scene, ray.at(t)).max() == 0) continue;
       bool covered = false;
-      for (const MajorantSegment& s : w.segments) covered = covered || (s.t0 <= t && t <= s.t1);
+      for (const MajorantSegment<3>& s : w.segments) covered = covered || (s.t0 <= t && t <= s.t1);
       EXPECT_TRUE(covered) << "ray " << r << " t " << t;
     }
   }
@@ -182,13 +202,13 @@ TEST(Octree, WalkSkipsEmptyLeavesAndStopsWhenAsked) {
   for (int r = 0; r < 100; ++r) {
     const Ray ray = random_ray(tree.box, rng);
     int leaves = 0;
-    walk_octree(tree, ray, 0, 10, [&](const OctreeNode& node, double, double) {
-      EXPECT_FALSE(node.empty);
+    walk_octree(tree, ray, 0, 10, [&](std::int32_t node, double, double) {
+      EXPECT_FALSE(tree.nodes[node].empty);
       ++leaves;
       return true;
     });
     int calls = 0;
-    const bool finished = walk_octree(tree, ray, 0, 10, [&](const OctreeNode&, double, double) {
+    const bool finished = walk_octree(tree, ray, 0, 10, [&](std::int32_t, double, double) {
       ++calls;
       return false;
     });
@@ -202,8 +222,8 @@ void expect_same_nodes(const MajorantOctree& a, const MajorantOctree& b) {
   for (size_t i = 0; i < a.nodes.size(); ++i) {
     EXPECT_EQ(a.nodes[i].children, b.nodes[i].children) << i;
     EXPECT_EQ(a.nodes[i].empty, b.nodes[i].empty) << i;
-    EXPECT_TRUE(a.nodes[i].mu_bar == b.nodes[i].mu_bar) << i;
-    EXPECT_TRUE(a.nodes[i].mu_c == b.nodes[i].mu_c) << i;
+    EXPECT_TRUE(node_mu_bar(a, i) == node_mu_bar(b, i)) << i;
+    EXPECT_TRUE(node_mu_c(a, i) == node_mu_c(b, i)) << i;
   }
 }
 
@@ -231,15 +251,16 @@ TEST(Octree, SampledBoundsAreFiniteAndOrdered) {
     const OctreeNode& n = sampled.nodes[i];
     EXPECT_EQ(n.empty, bound.nodes[i].empty);
     if (n.empty) continue;
+    const Rgb n_bar = node_mu_bar(sampled, i), n_c = node_mu_c(sampled, i);
     for (int c = 0; c < 3; ++c) {
-      EXPECT_TRUE(std::isfinite(n.mu_bar[c]) && std::isfinite(n.mu_c[c])) << i;
-      EXPECT_LE(0.0, n.mu_c[c]);
-      EXPECT_LE(n.mu_c[c], n.mu_bar[c]);
+      EXPECT_TRUE(std::isfinite(n_bar[c]) && std::isfinite(n_c[c])) << i;
+      EXPECT_LE(0.0, n_c[c]);
+      EXPECT_LE(n_c[c], n_bar[c]);
       // Samples of mu_t lie within the conservative bounds.
-      EXPECT_LE(n.mu_bar[c], bound.nodes[i].mu_bar[c]);
-      EXPECT_GE(n.mu_c[c], bound.nodes[i].mu_c[c]);
+      EXPECT_LE(n_bar[c], node_mu_bar(bound, i)[c]);
+      EXPECT_GE(n_c[c], node_mu_c(bound, i)[c]);
     }
-    tighter += n.mu_bar.max() < bound.nodes[i].mu_bar.max();
+    tighter += n_bar.max() < node_mu_bar(bound, i).max();
   }
   EXPECT_GT(tighter, 10);
 }
@@ -254,7 +275,8 @@ TEST(Octree, DepthZeroIsOneNodeAndDeepTreesStayBounded) {
   EXPECT_LE(deep.field_octree.nodes.size(), kOctreeMaxNodes);
   EXPECT_GE(deep.field_octree.depth, 5);
   EXPECT_EQ(deep.field_octree.bytes(),
-            sizeof(MajorantOctree) + deep.field_octree.nodes.size() * sizeof(OctreeNode));
+            sizeof(MajorantOctree) + deep.field_octree.nodes.size() * sizeof(OctreeNode) +
+                deep.field_octree.nodes.size() * 2 * 3 * sizeof(double));
 }
 
 TEST(Octree, ASmallDenseFeatureIsRefinedToTheFullDepth) {
@@ -287,10 +309,9 @@ TEST(Octree, ConstantMediumInsideASolidIsOneNode) {
   EXPECT_TRUE(scene.field_octree.nodes.empty());
   ASSERT_EQ(scene.solid_octrees.size(), 1u);
   ASSERT_EQ(scene.solid_octrees[0].nodes.size(), 1u);
-  const OctreeNode& root = scene.solid_octrees[0].nodes[0];
   for (int c = 0; c < 3; ++c) {
-    EXPECT_NEAR(root.mu_bar[c], m.sigma_s[c], 1e-9);
-    EXPECT_NEAR(root.mu_c[c], m.sigma_s[c], 1e-9);
+    EXPECT_NEAR(node_mu_bar(scene.solid_octrees[0], 0)[c], m.sigma_s.rgb[c], 1e-9);
+    EXPECT_NEAR(node_mu_c(scene.solid_octrees[0], 0)[c], m.sigma_s.rgb[c], 1e-9);
   }
 }
 

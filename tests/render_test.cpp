@@ -16,7 +16,7 @@ namespace {
 
 Scene sphere_scene(const Surface& surface, int size, int spp) {
   Scene scene;
-  scene.settings = {size, size, spp, 7, 1000, {}};
+  scene.settings = {size, size, spp, 7, 1000, {}, {}};
   scene.camera = orthographic_camera({0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 2.5, size, size);
   SceneObject obj;
   obj.tape = compile(*make_shape(QuadricNode{sphere({0, 0, 0}, 1)}));
@@ -25,7 +25,7 @@ Scene sphere_scene(const Surface& surface, int size, int spp) {
   scene.objects.push_back(obj);
   Light env;
   env.type = Light::Type::Environment;
-  env.radiance = Rgb(1.0);
+  env.emission = Rgb(1.0);
   scene.lights.push_back(env);
   return scene;
 }
@@ -60,12 +60,12 @@ TEST(Render, ConvexDiffuseObjectRendersItsAlbedoUnderUniformLight) {
   diffuse.albedo = Rgb({0.8, 0.5, 0.2});
   const Scene scene = sphere_scene(diffuse, 24, 64);
   const RenderResult r = render(scene);
-  expect_region(r.film, pixels_by_disc(scene, true), diffuse.albedo);
+  expect_region(r.film, pixels_by_disc(scene, true), diffuse.albedo.rgb);
   expect_region(r.film, pixels_by_disc(scene, false), Rgb(1.0));
   // Per pixel too: every inside pixel is within 5 standard errors of the albedo.
   for (int p : pixels_by_disc(scene, true))
     for (int c = 0; c < 3; ++c)
-      EXPECT_NEAR(r.film.mean(p)[c], diffuse.albedo[c],
+      EXPECT_NEAR(r.film.mean(p)[c], diffuse.albedo.rgb[c],
                   5 * std::sqrt(r.film.variance_of_mean(p)[c]) + 1e-12);
 }
 
@@ -86,7 +86,7 @@ TEST(Render, ImageIsBitIdenticalForAnyThreadCount) {
   Light sun;
   sun.type = Light::Type::Directional;
   sun.direction = normalize(Vec3{-1, -1, -1});
-  sun.irradiance = Rgb(2.0);
+  sun.emission = Rgb(2.0);
   scene.lights.push_back(sun);
   const RenderResult one = render(scene, {1, {}});
   const RenderResult two = render(scene, {2, {}});
@@ -112,7 +112,7 @@ void expect_sphere_light_on_floor(TrackingSettings::Mode mode) {
   const double r = 0.6, L_s = 5.0, albedo = 0.7;
   const Vec3 c{0.3, 2.0, -0.2};
   Scene scene;
-  scene.settings = {size, size, 512, 9, 1000, {}};
+  scene.settings = {size, size, 512, 9, 1000, {}, {}};
   scene.settings.tracking.mode = mode;
   // Looking down at the floor from the side, past the light; the view is 1 unit wide.
   scene.camera = orthographic_camera({3, 3, 3}, {0, 0, 0}, {0, 1, 0}, 1.0, size, size);
@@ -126,7 +126,7 @@ void expect_sphere_light_on_floor(TrackingSettings::Mode mode) {
   light.type = Light::Type::Sphere;
   light.center = c;
   light.radius = r;
-  light.radiance = Rgb(L_s);
+  light.emission = Rgb(L_s);
   scene.lights.push_back(light);
   const RenderResult res = render(scene);
 

@@ -9,6 +9,7 @@
 
 #include "nimbus/frep/primitives.h"
 #include "nimbus/scene/load.h"
+#include "nimbus/spectral/color.h"
 
 namespace nimbus {
 namespace {
@@ -259,6 +260,52 @@ std::vector<BadScene> bad_scenes() {
        with_object(R"({"shape": )" + ball + R"(, "surface": {"type": "dielectric", "ior": 0.9}})"),
        {},
        "scene.json: /objects/0/surface/ior: must be >= 1"},
+      {"spectrum mode unknown",
+       with_camera(R"("spectrum": {"mode": "hyper"})"),
+       {},
+       R"(scene.json: /spectrum/mode: unknown spectrum mode "hyper" (expected one of: rgb, spectral))"},
+      {"too few wavelengths",
+       with_camera(R"("spectrum": {"mode": "spectral", "wavelengths": 3})"),
+       {},
+       "scene.json: /spectrum/wavelengths: must be in [4, 16]"},
+      {"sampled spectrum not increasing",
+       with_medium(R"({"sigma_s": {"spectrum": [[400, 1], [700, 2], [650, 3]]}})"),
+       {},
+       "scene.json: /media/cloud/sigma_s/spectrum/2/0: wavelengths must increase (after 700 nm)"},
+      {"sampled spectrum empty",
+       with_medium(R"({"sigma_s": {"spectrum": []}})"),
+       {},
+       "scene.json: /media/cloud/sigma_s/spectrum: expected at least one [nm, value] pair"},
+      {"sampled spectrum entry not a pair",
+       with_medium(R"({"sigma_a": {"spectrum": [[400, 1, 2]]}})"),
+       {},
+       "scene.json: /media/cloud/sigma_a/spectrum/0: expected a pair [nm, value]"},
+      {"sampled coefficient negative",
+       with_medium(R"({"sigma_a": {"spectrum": [[400, 1], [500, -2]]}})"),
+       {},
+       "scene.json: /media/cloud/sigma_a/spectrum/1/1: must be >= 0"},
+      {"sampled albedo above 1",
+       with_object(R"({"shape": )" + ball +
+                   R"(, "surface": {"albedo": {"spectrum": [[400, 0.5], [600, 1.2]]}}})"),
+       {},
+       "scene.json: /objects/0/surface/albedo/spectrum/1/1: must be in [0, 1]"},
+      {"blackbody albedo",
+       with_object(R"({"shape": )" + ball + R"(, "surface": {"albedo": {"blackbody": 3000}}})"),
+       {},
+       R"(scene.json: /objects/0/surface/albedo/blackbody: unknown key (expected "spectrum"))"},
+      {"blackbody too cold",
+       with_camera(R"("lights": [{"type": "environment", "radiance": {"blackbody": 5}}])"),
+       {},
+       "scene.json: /lights/0/radiance/blackbody: must be in [100, 1e+06]"},
+      {"spectrum and blackbody",
+       with_camera(
+           R"("lights": [{"type": "environment", "radiance": {"blackbody": 5000, "spectrum": [[500, 1]]}}])"),
+       {},
+       R"(scene.json: /lights/0/radiance/blackbody: give either "spectrum" or "blackbody", not both)"},
+      {"colour object without a spectrum",
+       with_medium(R"({"sigma_s": {}})"),
+       {},
+       R"(scene.json: /media/cloud/sigma_s: expected a number, [r, g, b] or {"spectrum": [[nm, value], ...]})"},
       {"albedo above 1",
        with_object(R"({"shape": )" + ball + R"(, "surface": {"albedo": [0.5, 1.5, 0.5]}})"),
        {},
@@ -338,10 +385,10 @@ TEST(SceneLoad, ExampleLoads) {
 
   ASSERT_EQ(s.lights.size(), 4u);
   EXPECT_EQ(s.lights[0].type, LightDesc::Type::Environment);
-  EXPECT_EQ(s.lights[0].radiance, Rgb({0.8, 0.9, 1.0}));
+  EXPECT_EQ(s.lights[0].radiance.rgb, Rgb({0.8, 0.9, 1.0}));
   EXPECT_EQ(s.lights[1].type, LightDesc::Type::Directional);
   EXPECT_EQ(s.lights[1].direction, (Vec3{0, -1, 0}));
-  EXPECT_EQ(s.lights[1].irradiance, Rgb(3));
+  EXPECT_EQ(s.lights[1].irradiance.rgb, Rgb(3));
   EXPECT_EQ(s.lights[2].type, LightDesc::Type::Point);
   EXPECT_EQ(s.lights[2].position, (Vec3{1, 4, 2}));
   EXPECT_EQ(s.lights[3].type, LightDesc::Type::Sphere);
@@ -355,10 +402,10 @@ TEST(SceneLoad, ExampleLoads) {
   EXPECT_EQ(s.media[0].density.type, DensityDesc::Type::Cloud);
   EXPECT_EQ(s.media[0].density.seed, 7u);
   EXPECT_EQ(s.media[1].name, "fire");
-  EXPECT_EQ(s.media[1].emission, Rgb({4, 1.5, 0.2}));
+  EXPECT_EQ(s.media[1].emission.rgb, Rgb({4, 1.5, 0.2}));
   EXPECT_EQ(s.media[1].phase.type, PhaseDesc::Type::Isotropic);
   EXPECT_EQ(s.media[2].name, "haze");
-  EXPECT_EQ(s.media[2].sigma_a, Rgb(0.05));
+  EXPECT_EQ(s.media[2].sigma_a.rgb, Rgb(0.05));
   EXPECT_EQ(s.media[2].density.type, DensityDesc::Type::Field);
   EXPECT_EQ(s.media[2].density.scale, 2.0);
   EXPECT_EQ(s.media[3].name, "marble");
@@ -367,9 +414,9 @@ TEST(SceneLoad, ExampleLoads) {
   EXPECT_EQ(s.objects[0].shape_name, "blob");
   EXPECT_EQ(s.objects[0].json_path, "/objects/0");
   EXPECT_EQ(s.objects[0].surface.type, SurfaceDesc::Type::Diffuse);
-  EXPECT_EQ(s.objects[0].surface.albedo, Rgb({0.7, 0.5, 0.3}));
+  EXPECT_EQ(s.objects[0].surface.albedo.rgb, Rgb({0.7, 0.5, 0.3}));
   EXPECT_EQ(s.objects[0].medium, -1);
-  EXPECT_EQ(s.objects[1].surface.albedo, Rgb(0.5));
+  EXPECT_EQ(s.objects[1].surface.albedo.rgb, Rgb(0.5));
   EXPECT_EQ(s.objects[2].medium, 3);
   EXPECT_EQ(s.objects[2].surface.type, SurfaceDesc::Type::Dielectric);
   EXPECT_EQ(s.objects[3].medium, 0);
@@ -380,6 +427,33 @@ TEST(SceneLoad, ExampleLoads) {
   ASSERT_NE(floor, nullptr);
   EXPECT_EQ(floor->op, CsgOp::Intersection);
   EXPECT_EQ(floor->children.size(), 3u);
+}
+
+TEST(SceneLoad, SpectralModeAndSpectralColours) {
+  const SceneDesc s = load(with_camera(R"(
+    "spectrum": {"mode": "spectral", "wavelengths": 12},
+    "lights": [{"type": "environment", "radiance": {"blackbody": 6500, "scale": 2}},
+               {"type": "point", "position": [0, 1, 0], "intensity": [1, 0.5, 0.25]}],
+    "media": {"jade": {"sigma_s": {"spectrum": [[400, 1], [550, 4], [700, 2]]},
+                       "sigma_a": 0.1}})"));
+  EXPECT_EQ(s.spectrum.mode, "spectral");
+  EXPECT_EQ(s.spectrum.wavelengths, 12);
+  // A blackbody keeps its curve; rgb mode gets its projection, of luminance `scale`.
+  ASSERT_TRUE(s.lights[0].radiance.curve.has_value());
+  EXPECT_EQ(s.lights[0].radiance.curve->type, SpectralCurve::Type::Blackbody);
+  EXPECT_NEAR(linear_srgb_to_xyz(s.lights[0].radiance.rgb).y, 2.0, 1e-3);
+  // RGB inputs get their curves when the scene is compiled.
+  EXPECT_FALSE(s.lights[1].intensity.curve.has_value());
+  EXPECT_EQ(s.lights[1].intensity.rgb, Rgb({1, 0.5, 0.25}));
+  const SpectralParam& sigma_s = s.media[0].sigma_s;
+  ASSERT_TRUE(sigma_s.curve.has_value());
+  EXPECT_DOUBLE_EQ((*sigma_s.curve)(475), 2.5);
+  EXPECT_DOUBLE_EQ((*sigma_s.curve)(300), 1.0);  // held beyond the ends
+  // Its rgb-mode value is its projection: greenish, every component within the curve's range.
+  EXPECT_GT(sigma_s.rgb[1], sigma_s.rgb[0]);
+  EXPECT_GT(sigma_s.rgb[1], sigma_s.rgb[2]);
+  for (int c = 0; c < 3; ++c) EXPECT_TRUE(sigma_s.rgb[c] >= 0.5 && sigma_s.rgb[c] <= 4.5) << c;
+  EXPECT_EQ(load(with_camera("")).spectrum.mode, "rgb");
 }
 
 TEST(SceneLoad, NamedShapesAreBuiltOnceAndShared) {
@@ -426,12 +500,12 @@ TEST(SceneLoad, DefaultsApplyWhereKeysAreOptional) {
   EXPECT_EQ(s.integrator.octree.depth, 4);
   EXPECT_TRUE(s.lights.empty());
   ASSERT_EQ(s.media.size(), 1u);
-  EXPECT_TRUE(s.media[0].sigma_s.is_black());
+  EXPECT_TRUE(s.media[0].sigma_s.rgb.is_black());
   EXPECT_EQ(s.media[0].density.type, DensityDesc::Type::Constant);
   EXPECT_EQ(s.media[0].density.scale, 1.0);
   EXPECT_EQ(s.objects[0].shape_name, "inline");
   EXPECT_EQ(s.objects[0].surface.type, SurfaceDesc::Type::Diffuse);
-  EXPECT_EQ(s.objects[0].surface.albedo, Rgb(0.5));
+  EXPECT_EQ(s.objects[0].surface.albedo.rgb, Rgb(0.5));
   EXPECT_EQ(s.objects[1].surface.type, SurfaceDesc::Type::None);
   EXPECT_EQ(s.objects[1].medium, 0);
 }
@@ -507,7 +581,7 @@ TEST(SceneLoad, OverridesReplaceAndCreateValues) {
   EXPECT_EQ(s.camera.type, CameraDesc::Type::Orthographic);
   EXPECT_EQ(s.integrator.majorant.scale, 1.5);
   EXPECT_EQ(s.film.width, 200);  // the last override wins
-  EXPECT_EQ(s.lights[0].radiance, Rgb({0.1, 0.2, 0.3}));
+  EXPECT_EQ(s.lights[0].radiance.rgb, Rgb({0.1, 0.2, 0.3}));
   EXPECT_EQ(s.integrator.tracking, "spectral-mis");
   EXPECT_EQ(s.integrator.octree.depth, 3);
 }

@@ -11,7 +11,7 @@ namespace nimbus::test {
 inline Light environment(double radiance) {
   Light env;
   env.type = Light::Type::Environment;
-  env.radiance = Rgb(radiance);
+  env.emission = Rgb(radiance);
   return env;
 }
 
@@ -26,11 +26,12 @@ inline SceneObject object_of(const ShapePtr& shape, Surface::Type surface, int m
   return obj;
 }
 
-// Field objects and majorant octrees, as compile_scene derives them.
+// Field objects, spectra and majorant octrees, as compile_scene derives them.
 inline void finish_media(Scene& scene) {
   for (size_t i = 0; i < scene.objects.size(); ++i)
     if (scene.objects[i].surface.type == Surface::Type::None && scene.objects[i].medium >= 0)
       scene.field_objects.push_back(static_cast<int>(i));
+  complete_spectra(scene);
   build_majorant_octrees(scene);
 }
 

@@ -2,6 +2,7 @@
 // The medium as a field (DESIGN.md): wherever an index-matched object's function is positive its
 // medium is present, and overlapping media add. Inside a solid object (a dielectric with a
 // medium) only that object's medium is present: a solid displaces the media around it.
+// Everything here works on a path's N channels (render/path_spectra.h).
 
 #include <array>
 #include <utility>
@@ -10,69 +11,162 @@
 #include "nimbus/math/ray.h"
 #include "nimbus/media/medium.h"
 #include "nimbus/media/octree.h"
+#include "nimbus/media/phase.h"
+#include "nimbus/render/path_spectra.h"
 #include "nimbus/render/scene.h"
 #include "nimbus/spectral/spectrum.h"
 
 namespace nimbus {
 
+inline constexpr int kMaxMediaAtPoint = 8;
+
 // The coefficients at a point, with the phase function of the mixture of media present there.
+template <int N>
 struct MediumPoint {
-  static constexpr int kMaxMedia = 8;
-  Rgb mu_a{0.0}, mu_s{0.0};
-  Rgb mu_a_Le{0.0};  // Σ mu_a,i L_e,i
-  int media = 0;     // how many media contribute
+  static constexpr int kMaxMedia = kMaxMediaAtPoint;
+  Spectrum<N> mu_a{0.0}, mu_s{0.0};
+  Spectrum<N> mu_a_Le{0.0};  // Σ mu_a,i L_e,i
+  int media = 0;             // how many media contribute
   std::array<double, kMaxMedia> g{};
-  std::array<Rgb, kMaxMedia> mu_s_i{};  // each medium's scattering coefficient
-  Rgb mu_t() const { return mu_a + mu_s; }
+  std::array<Spectrum<N>, kMaxMedia> mu_s_i{};  // each medium's scattering coefficient
+  Spectrum<N> mu_t() const { return mu_a + mu_s; }
 };
 
-// `inside` is the solid object the point is in (-1: none).
-MediumPoint medium_at(const Scene& scene, const Vec3& x, int inside);
+// The density (the factor on sigma_a, sigma_s) of `medium` at x, where its object's F is F.
+double medium_density(const Medium& medium, const Vec3& x, double F);
+
+// Calls f(medium index, density) for each medium present at x (at most kMaxMediaAtPoint), seen
+// from `inside`, the solid object the point is in (-1: none).
+template <class F>
+void for_each_medium_at(const Scene& scene, const Vec3& x, int inside, F&& f) {
+  if (inside >= 0) {
+    const SceneObject& obj = scene.objects[inside];
+    if (obj.medium < 0) return;
+    const Medium& medium = scene.media[obj.medium];
+    const double F_x = medium.density == Medium::Density::Constant ? 1.0 : evaluate(obj.tape, x);
+    const double d = medium_density(medium, x, F_x);
+    if (d > 0) f(obj.medium, d);
+    return;
+  }
+  int count = 0;
+  for (int i : scene.field_objects) {
+    const SceneObject& obj = scene.objects[i];
+    if (!obj.bounds.contains(x)) continue;
+    const double F_x = evaluate(obj.tape, x);
+    if (F_x <= 0) continue;
+    const double d = medium_density(scene.media[obj.medium], x, F_x);
+    if (d <= 0) continue;
+    f(obj.medium, d);
+    if (++count == kMaxMediaAtPoint) return;
+  }
+}
+
+template <int N>
+MediumPoint<N> medium_at(const Scene& scene, const PathSpectra<N>& ps, const Vec3& x, int inside) {
+  MediumPoint<N> m;
+  for_each_medium_at(scene, x, inside, [&](int medium, double density) {
+    const MediumCoefficients<N>& c = ps.media[medium];
+    const Spectrum<N> mu_a = c.sigma_a * density, mu_s = c.sigma_s * density;
+    m.mu_a += mu_a;
+    m.mu_s += mu_s;
+    m.mu_a_Le += mu_a * c.emission;
+    m.g[m.media] = scene.media[medium].g;
+    m.mu_s_i[m.media] = mu_s;
+    ++m.media;
+  });
+  return m;
+}
 
 // A stretch of a ray with a majorant mu_bar and a minorant mu_c of mu_t there, per channel.
 // mu_bar is multiplied by the scene's majorant scale, so it need not bound when that is < 1.
+template <int N>
 struct MajorantSegment {
   double t0, t1;
-  Rgb mu_bar;
-  Rgb mu_c{0.0};
+  Spectrum<N> mu_bar;
+  Spectrum<N> mu_c{0.0};
 };
 
-// Calls f(const MajorantSegment&) for the majorant segments covering the media along the ray in
-// [t_min, t_max], in order, from the leaves of the scene's majorant octree (octree.h) for
-// `inside` (-1: the field; else that solid object). Where no medium can be there is a gap;
-// neighbouring leaves with identical bounds become one segment. f returns false to stop the
-// walk. The ray direction must be unit length.
-template <class F>
-void walk_majorant_segments(const Scene& scene, const Ray& ray, double t_min, double t_max,
-                            int inside, F&& f) {
+// Calls f(const MajorantSegment<N>&) for the majorant segments covering the media along the ray
+// in [t_min, t_max], in order, from the leaves of the scene's majorant octree (octree.h) for
+// `inside` (-1: the field; else that solid object), each channel taking its bin's bounds. Where
+// no medium can be there is a gap; neighbouring leaves with identical bounds become one segment.
+// f returns false to stop the walk. The ray direction must be unit length.
+template <int N, class F>
+void walk_majorant_segments(const Scene& scene, const Channels<N>& ch, const Ray& ray,
+                            double t_min, double t_max, int inside, F&& f) {
   if (inside >= 0 && scene.objects[inside].medium < 0) return;  // a solid without a medium
   // at(): a scene whose octrees were never built fails loudly rather than reading past the end.
   const MajorantOctree& tree = inside >= 0 ? scene.solid_octrees.at(inside) : scene.field_octree;
   const double scale = scene.settings.tracking.majorant_scale;
-  MajorantSegment pending{0, 0, Rgb(0.0), Rgb(0.0)};
+  MajorantSegment<N> pending{0, 0, Spectrum<N>(0.0), Spectrum<N>(0.0)};
   bool has_pending = false;
-  const bool finished =
-      walk_octree(tree, ray, t_min, t_max, [&](const OctreeNode& node, double a, double b) {
-        const Rgb mu_bar = node.mu_bar * scale;
-        if (has_pending && a == pending.t1 && mu_bar == pending.mu_bar &&
-            node.mu_c == pending.mu_c) {
-          pending.t1 = b;
-          return true;
-        }
-        if (has_pending && !f(std::as_const(pending))) return false;
-        pending = {a, b, mu_bar, node.mu_c};
-        has_pending = true;
-        return true;
-      });
+  const bool finished = walk_octree(tree, ray, t_min, t_max, [&](std::int32_t node, double a,
+                                                                 double b) {
+    const double* hi = tree.mu_bar(node);
+    const double* lo = tree.mu_c(node);
+    Spectrum<N> mu_bar, mu_c;
+    for (int c = 0; c < N; ++c) {
+      mu_bar[c] = hi[ch.bin[c]] * scale;
+      mu_c[c] = lo[ch.bin[c]];
+    }
+    if (has_pending && a == pending.t1 && mu_bar == pending.mu_bar && mu_c == pending.mu_c) {
+      pending.t1 = b;
+      return true;
+    }
+    if (has_pending && !f(std::as_const(pending))) return false;
+    pending = {a, b, mu_bar, mu_c};
+    has_pending = true;
+    return true;
+  });
   if (finished && has_pending) f(std::as_const(pending));
 }
 
-// The mixture phase function at a scattering point: value per channel and its sampling.
-Rgb phase_value(const MediumPoint& m, double cos_theta);
+// The mixture phase function at a scattering point: value per channel.
+template <int N>
+Spectrum<N> phase_value(const MediumPoint<N>& m, double cos_theta) {
+  Spectrum<N> p(0.0);
+  for (int i = 0; i < m.media; ++i) p += m.mu_s_i[i] * hg_phase(cos_theta, m.g[i]);
+  for (int c = 0; c < N; ++c) p[c] = m.mu_s[c] > 0 ? p[c] / m.mu_s[c] : 0.0;
+  return p;
+}
+
+// The density with which sample_phase picks a direction.
+template <int N>
+double phase_pdf(const MediumPoint<N>& m, double cos_theta) {
+  const double total = m.mu_s.sum();
+  if (m.media == 1 || total <= 0) return hg_phase(cos_theta, m.g[0]);
+  double pdf = 0;
+  for (int i = 0; i < m.media; ++i) pdf += m.mu_s_i[i].sum() / total * hg_phase(cos_theta, m.g[i]);
+  return pdf;
+}
+
 // Picks a medium with probability ∝ its average mu_s, then samples its HG lobe; returns the
 // direction and the per-channel weight phase_value / pdf (exactly 1 for a single medium).
-Vec3 sample_phase(const MediumPoint& m, const Vec3& dir, double u0, double u1, double u2,
-                  Rgb& weight, double& pdf);
-double phase_pdf(const MediumPoint& m, double cos_theta);
+template <int N>
+Vec3 sample_phase(const MediumPoint<N>& m, const Vec3& dir, double u0, double u1, double u2,
+                  Spectrum<N>& weight, double& pdf) {
+  if (m.media <= 1) {
+    const Vec3 w = sample_hg(dir, m.g[0], u1, u2);
+    weight = Spectrum<N>(1.0);
+    pdf = hg_phase(dot(dir, w), m.g[0]);
+    return w;
+  }
+  // One-sample mixture: pick a lobe ∝ its share of mu_s, weight by the exact mixture.
+  const double total = m.mu_s.sum();
+  int pick = m.media - 1;
+  double acc = 0;
+  for (int i = 0; i < m.media; ++i) {
+    acc += m.mu_s_i[i].sum() / total;
+    if (u0 < acc) {
+      pick = i;
+      break;
+    }
+  }
+  const Vec3 w = sample_hg(dir, m.g[pick], u1, u2);
+  const double cos_theta = dot(dir, w);
+  pdf = phase_pdf(m, cos_theta);
+  weight = pdf > 0 ? phase_value(m, cos_theta) / pdf : Spectrum<N>(0.0);
+  return w;
+}
 
 }  // namespace nimbus

@@ -7,22 +7,44 @@
 
 #include "nimbus/math/rng.h"
 #include "nimbus/media/medium_field.h"
+#include "nimbus/render/path_spectra.h"
 #include "nimbus/render/scene.h"
+#include "nimbus/spectral/wavelengths.h"
 
 namespace nimbus {
 namespace {
 
-// An object whose medium the tree covers.
+// An object whose medium the tree covers, with its medium's sigma_t bounds per bin.
 struct Member {
   const SceneObject* object;
   const Medium* medium;
+  const double* sigma_t_hi;
+  const double* sigma_t_lo;
 };
 
-// Bounds of mu_t over a box: the sum over members of sigma_t times their density range there.
-struct Bounds3 {
-  Rgb hi{0.0}, lo{0.0};
-  bool empty = true;
-};
+// sigma_t = sigma_a + sigma_s of every medium per bin: in rgb mode the channels' values; in
+// spectral mode bounds over each bin's wavelength interval (hi, then lo, `bins` each).
+std::vector<std::vector<double>> sigma_t_bins(const Scene& scene, int bins) {
+  std::vector<std::vector<double>> out;
+  const bool spectral = scene.settings.spectral.mode == SpectralSettings::Mode::Spectral;
+  for (const Medium& m : scene.media) {
+    std::vector<double> v(2 * bins);
+    for (int b = 0; b < bins; ++b) {
+      if (!spectral) {
+        v[b] = v[bins + b] = m.sigma_a.rgb[b] + m.sigma_s.rgb[b];
+        continue;
+      }
+      const double lo = sample_visible_wavelength(double(b) / bins);
+      const double hi = b + 1 == bins ? kLambdaMax : sample_visible_wavelength(double(b + 1) / bins);
+      const auto [a_lo, a_hi] = m.sigma_a.curve->range(lo, hi);
+      const auto [s_lo, s_hi] = m.sigma_s.curve->range(lo, hi);
+      v[b] = a_hi + s_hi;
+      v[bins + b] = std::max(0.0, a_lo + s_lo);
+    }
+    out.push_back(std::move(v));
+  }
+  return out;
+}
 
 // The density range of one member over a box, from the interval of F. Inside a solid, a
 // constant medium is constant wherever the ray can be (medium_at ignores F there).
@@ -57,32 +79,47 @@ bool density_range(const Member& m, const Box& box, bool solid, double& lo, doub
 // margin far above round-off keeps the bounds conservative.
 constexpr double kRoundOff = 1e-12;
 
-Bounds3 interval_bounds(const std::vector<Member>& members, const Box& box, bool solid) {
-  Bounds3 r;
+// Bounds of mu_t over a box, the sum over members of sigma_t times their density range there,
+// into out[0, bins) (majorants) and out[bins, 2 bins) (minorants). False if no medium can be
+// in the box.
+bool interval_bounds(const std::vector<Member>& members, const Box& box, bool solid, int bins,
+                     double* out) {
+  std::fill(out, out + 2 * bins, 0.0);
+  bool any = false;
   for (const Member& m : members) {
     double lo = 0, hi = 0;
     // A density bounded by 0 (a cloud eroded away near its surface) is no medium either.
     if (!density_range(m, box, solid, lo, hi) || !(hi > 0)) continue;
-    const Rgb sigma_t = m.medium->sigma_a + m.medium->sigma_s;
-    r.hi += sigma_t * hi;
-    r.lo += sigma_t * lo;
-    r.empty = false;
+    for (int b = 0; b < bins; ++b) {
+      out[b] += m.sigma_t_hi[b] * hi;
+      out[bins + b] += m.sigma_t_lo[b] * lo;
+    }
+    any = true;
   }
-  r.hi *= 1 + kRoundOff;
-  r.lo *= 1 - kRoundOff;
+  for (int b = 0; b < bins; ++b) {
+    out[b] *= 1 + kRoundOff;
+    out[bins + b] *= 1 - kRoundOff;
+  }
+  return any;
+}
+
+// The largest gap between majorant and minorant over the bins.
+double null_rate(const double* bounds, int bins) {
+  double r = 0;
+  for (int b = 0; b < bins; ++b) r = std::max(r, bounds[b] - bounds[bins + b]);
   return r;
 }
 
-double null_optical_depth(const OctreeNode& n, const Vec3& half) {
-  return (n.mu_bar - n.mu_c).max() * 2 * length(half);
+double null_optical_depth(const double* bounds, int bins, const Vec3& half) {
+  return null_rate(bounds, bins) * 2 * length(half);
 }
 
-bool wants_split(const OctreeNode& n, const Vec3& half) {
+bool wants_split(const OctreeNode& n, const double* bounds, int bins, const Vec3& half) {
   if (n.empty) return false;
   bool homogeneous = true;
-  for (int c = 0; c < 3; ++c)
-    homogeneous = homogeneous && n.mu_bar[c] - n.mu_c[c] <= kOctreeHomogeneous * n.mu_bar[c];
-  return !homogeneous && null_optical_depth(n, half) > kOctreeThinNull;
+  for (int b = 0; b < bins; ++b)
+    homogeneous = homogeneous && bounds[b] - bounds[bins + b] <= kOctreeHomogeneous * bounds[b];
+  return !homogeneous && null_optical_depth(bounds, bins, half) > kOctreeThinNull;
 }
 
 Box box_of(const Vec3& center, const Vec3& half) {
@@ -97,6 +134,7 @@ double mean_chord(const Vec3& half) {
 // The tree as built and the arrays that place its nodes, all in breadth-first order.
 struct Grown {
   std::vector<OctreeNode> nodes;
+  std::vector<double> bounds;  // 2 bins per node, as MajorantOctree::bounds
   std::vector<Vec3> centers;
   std::vector<int> levels;
 };
@@ -108,11 +146,12 @@ struct Grown {
 // cheaper the children go: a split that only halves the size without tightening the bounds
 // costs traversal for nothing.
 Grown prune(Grown g, const MajorantOctree& tree) {
+  const int bins = tree.bins;
   std::vector<double> cost(g.nodes.size());
   for (size_t i = g.nodes.size(); i-- > 0;) {
     OctreeNode& n = g.nodes[i];
     const double leaf = n.empty ? 1.0
-                                : 1.0 + kOctreeLookupCost * (n.mu_bar - n.mu_c).max() *
+                                : 1.0 + kOctreeLookupCost * null_rate(&g.bounds[2 * bins * i], bins) *
                                             mean_chord(tree.half[g.levels[i]]);
     cost[i] = leaf;
     if (n.children < 0) continue;
@@ -126,7 +165,12 @@ Grown prune(Grown g, const MajorantOctree& tree) {
   }
   // Breadth first again, over what is left: children stay contiguous and after their parent.
   Grown out;
+  auto copy_bounds = [&](size_t from_node) {
+    const auto first = g.bounds.begin() + 2 * bins * static_cast<std::ptrdiff_t>(from_node);
+    out.bounds.insert(out.bounds.end(), first, first + 2 * bins);
+  };
   out.nodes.push_back(g.nodes[0]);
+  copy_bounds(0);
   out.centers.push_back(g.centers[0]);
   out.levels.push_back(0);
   std::vector<size_t> from{0};
@@ -137,6 +181,7 @@ Grown prune(Grown g, const MajorantOctree& tree) {
     for (int k = 0; k < 8; ++k) {
       const size_t c = static_cast<size_t>(old_children) + k;
       out.nodes.push_back(g.nodes[c]);
+      copy_bounds(c);
       out.centers.push_back(g.centers[c]);
       out.levels.push_back(g.levels[c]);
       from.push_back(c);
@@ -145,49 +190,56 @@ Grown prune(Grown g, const MajorantOctree& tree) {
   return out;
 }
 
-// The paper's preliminary pass: min and max of mu_t at random points of each non-empty leaf.
-// Interior nodes then hold the hull of their children.
-void sample_bounds(const Scene& scene, int inside, const std::vector<Vec3>& centers,
-                   const std::vector<int>& levels, const MajorantOctree& tree,
-                   std::vector<OctreeNode>& nodes) {
+// The paper's preliminary pass: min and max of mu_t at random points of each non-empty leaf,
+// per bin (in spectral mode from each medium's sigma_t bounds over the bin). Interior nodes then
+// hold the hull of their children.
+void sample_bounds(const Scene& scene, int inside, const std::vector<std::vector<double>>& sigma_t,
+                   const MajorantOctree& tree, Grown& g) {
   const int samples = std::max(1, scene.settings.tracking.majorant_samples);
+  const int bins = tree.bins;
   const uint64_t seed = splitmix64(scene.settings.seed ^ 0x6f637472656573ull);
-  tbb::parallel_for(size_t{0}, nodes.size(), [&](size_t i) {
-    OctreeNode& n = nodes[i];
+  tbb::parallel_for(size_t{0}, g.nodes.size(), [&](size_t i) {
+    const OctreeNode& n = g.nodes[i];
     if (n.children >= 0 || n.empty) return;
-    const Box box = box_of(centers[i], tree.half[levels[i]]);
+    const Box box = box_of(g.centers[i], tree.half[g.levels[i]]);
     Rng rng(seed, i);
-    Rgb lo(Box::kInf), hi(0.0);
+    double* out = &g.bounds[2 * bins * i];
+    std::fill(out, out + bins, 0.0);
+    std::fill(out + bins, out + 2 * bins, Box::kInf);
+    std::vector<double> mu(2 * bins);
     for (int s = 0; s < samples; ++s) {
       Vec3 x;
       for (int k = 0; k < 3; ++k) x[k] = box.lo[k] + rng.uniform() * (box.hi[k] - box.lo[k]);
-      const Rgb mu = medium_at(scene, x, inside).mu_t();
-      for (int c = 0; c < 3; ++c) {
-        lo[c] = std::min(lo[c], mu[c]);
-        hi[c] = std::max(hi[c], mu[c]);
+      std::fill(mu.begin(), mu.end(), 0.0);
+      for_each_medium_at(scene, x, inside, [&](int medium, double density) {
+        for (int b = 0; b < 2 * bins; ++b) mu[b] += density * sigma_t[medium][b];
+      });
+      for (int b = 0; b < bins; ++b) {
+        out[b] = std::max(out[b], mu[b]);
+        out[bins + b] = std::min(out[bins + b], mu[bins + b]);
       }
     }
-    n.mu_bar = hi;
-    n.mu_c = lo;
   });
   // Children come after their parent, so a backward sweep sees them first.
-  for (size_t i = nodes.size(); i-- > 0;) {
-    OctreeNode& n = nodes[i];
+  for (size_t i = g.nodes.size(); i-- > 0;) {
+    const OctreeNode& n = g.nodes[i];
     if (n.children < 0 || n.empty) continue;
-    Rgb lo(Box::kInf), hi(0.0);
+    double* out = &g.bounds[2 * bins * i];
+    std::fill(out, out + bins, 0.0);
+    std::fill(out + bins, out + 2 * bins, Box::kInf);
     bool any = false;
     for (int k = 0; k < 8; ++k) {
-      const OctreeNode& ch = nodes[n.children + k];
-      if (ch.empty) continue;
+      const size_t c = static_cast<size_t>(n.children) + k;
+      if (g.nodes[c].empty) continue;
       any = true;
-      for (int c = 0; c < 3; ++c) {
-        lo[c] = std::min(lo[c], ch.mu_c[c]);
-        hi[c] = std::max(hi[c], ch.mu_bar[c]);
+      const double* ch = &g.bounds[2 * bins * c];
+      for (int b = 0; b < bins; ++b) {
+        out[b] = std::max(out[b], ch[b]);
+        out[bins + b] = std::min(out[bins + b], ch[bins + b]);
       }
     }
     // The parent's interval did not exclude medium, its children's did: nothing to sample.
-    n.mu_bar = any ? hi : Rgb(0.0);
-    n.mu_c = any ? lo : Rgb(0.0);
+    if (!any) std::fill(out, out + 2 * bins, 0.0);
   }
 }
 
@@ -196,33 +248,39 @@ void sample_bounds(const Scene& scene, int inside, const std::vector<Vec3>& cent
 MajorantOctree build_majorant_octree(const Scene& scene, int inside) {
   const auto start = std::chrono::steady_clock::now();
   const TrackingSettings& settings = scene.settings.tracking;
+  MajorantOctree tree;
+  tree.bins =
+      scene.settings.spectral.mode == SpectralSettings::Mode::Spectral ? kSpectralBins : 3;
+  const int bins = tree.bins;
+  const std::vector<std::vector<double>> sigma_t = sigma_t_bins(scene, bins);
+  auto member = [&](const SceneObject& obj) {
+    const std::vector<double>& s = sigma_t[obj.medium];
+    return Member{&obj, &scene.media[obj.medium], s.data(), s.data() + bins};
+  };
   std::vector<Member> members;
   if (inside >= 0) {
     const SceneObject& obj = scene.objects[inside];
-    if (obj.medium >= 0) members.push_back({&obj, &scene.media[obj.medium]});
+    if (obj.medium >= 0) members.push_back(member(obj));
   } else {
-    for (int i : scene.field_objects)
-      members.push_back({&scene.objects[i], &scene.media[scene.objects[i].medium]});
+    for (int i : scene.field_objects) members.push_back(member(scene.objects[i]));
   }
-  MajorantOctree tree;
   for (const Member& m : members) tree.box = unite(tree.box, m.object->bounds);
   if (tree.box.empty()) return tree;
   const bool solid = inside >= 0;
   tree.half[0] = tree.box.extent() * 0.5;
   for (int l = 1; l <= kOctreeMaxDepth; ++l) tree.half[l] = tree.half[l - 1] * 0.5;
 
-  auto make_node = [&](const Vec3& center, const Vec3& half) {
-    const Bounds3 b = interval_bounds(members, box_of(center, half), solid);
+  auto make_node = [&](const Vec3& center, const Vec3& half, double* bounds) {
     OctreeNode n;
-    n.mu_bar = b.hi;
-    n.mu_c = b.lo;
-    n.empty = b.empty;
+    n.empty = !interval_bounds(members, box_of(center, half), solid, bins, bounds);
     return n;
   };
   // Node centers are computed as the walk computes them, so both see the same boxes.
-  std::vector<OctreeNode> nodes{make_node(tree.box.center(), tree.half[0])};
-  std::vector<Vec3> centers{tree.box.center()};
-  std::vector<int> levels{0};
+  Grown g;
+  g.bounds.resize(2 * bins);
+  g.nodes.push_back(make_node(tree.box.center(), tree.half[0], g.bounds.data()));
+  g.centers.push_back(tree.box.center());
+  g.levels.push_back(0);
   const int max_depth = std::clamp(settings.octree_depth, 0, kOctreeMaxDepth);
   size_t begin = 0, end = 1;
   for (int level = 0; level < max_depth; ++level) {
@@ -232,9 +290,12 @@ MajorantOctree build_majorant_octree(const Scene& scene, int inside) {
       size_t node;
     };
     std::vector<Candidate> split;
-    for (size_t i = begin; i < end; ++i)
-      if (wants_split(nodes[i], half)) split.push_back({null_optical_depth(nodes[i], half), i});
-    const size_t room = (kOctreeMaxNodes - nodes.size()) / 8;
+    for (size_t i = begin; i < end; ++i) {
+      const double* b = &g.bounds[2 * bins * i];
+      if (wants_split(g.nodes[i], b, bins, half))
+        split.push_back({null_optical_depth(b, bins, half), i});
+    }
+    const size_t room = (kOctreeMaxNodes - g.nodes.size()) / 8;
     if (split.size() > room) {
       // Keep the nodes where splitting can save the most null collisions; ties by index.
       std::sort(split.begin(), split.end(), [](const Candidate& a, const Candidate& b) {
@@ -246,27 +307,29 @@ MajorantOctree build_majorant_octree(const Scene& scene, int inside) {
     }
     if (split.empty()) break;
     const Vec3& child_half = tree.half[level + 1];
-    nodes.resize(end + 8 * split.size());
-    centers.resize(nodes.size());
-    levels.resize(nodes.size(), level + 1);
+    g.nodes.resize(end + 8 * split.size());
+    g.bounds.resize(2 * bins * g.nodes.size());
+    g.centers.resize(g.nodes.size());
+    g.levels.resize(g.nodes.size(), level + 1);
     tbb::parallel_for(size_t{0}, split.size(), [&](size_t s) {
       const size_t parent = split[s].node, first = end + 8 * s;
-      nodes[parent].children = static_cast<std::int32_t>(first);
+      g.nodes[parent].children = static_cast<std::int32_t>(first);
       for (int k = 0; k < 8; ++k) {
-        Vec3 c = centers[parent];
+        Vec3 c = g.centers[parent];
         for (int a = 0; a < 3; ++a) c[a] += (k >> a & 1) ? child_half[a] : -child_half[a];
-        centers[first + k] = c;
-        nodes[first + k] = make_node(c, child_half);
+        g.centers[first + k] = c;
+        g.nodes[first + k] = make_node(c, child_half, &g.bounds[2 * bins * (first + k)]);
       }
     });
     begin = end;
-    end = nodes.size();
+    end = g.nodes.size();
   }
-  Grown g = prune({std::move(nodes), std::move(centers), std::move(levels)}, tree);
+  g = prune(std::move(g), tree);
   tree.depth = *std::max_element(g.levels.begin(), g.levels.end());
   if (settings.majorant_source == TrackingSettings::MajorantSource::Sample)
-    sample_bounds(scene, inside, g.centers, g.levels, tree, g.nodes);
+    sample_bounds(scene, inside, sigma_t, tree, g);
   tree.nodes = std::move(g.nodes);
+  tree.bounds = std::move(g.bounds);
   tree.build_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return tree;

@@ -1,6 +1,6 @@
 #pragma once
 // The majorant octree (DESIGN.md, "Majorants and minorants are one structure"): an adaptive
-// octree over the media's bounds holding, per node and per channel, a majorant mu_bar and a
+// octree over the media's bounds holding, per node and per channel (bin), a majorant mu_bar and a
 // minorant mu_c of mu_t. Free-path estimators get their rates from a front-to-back walk of the
 // leaves a ray crosses, so tight bounds where the medium is thin mean few null collisions there.
 //
@@ -45,23 +45,34 @@ inline constexpr std::size_t kOctreeMaxNodes = std::size_t{1} << 18;
 inline constexpr double kOctreeLookupCost = 16;
 
 struct OctreeNode {
-  Rgb mu_bar{0.0};  // majorant of mu_t (the majorant scale is applied by the walk)
-  Rgb mu_c{0.0};    // minorant of mu_t
   // The first of 8 contiguous children, child k in octant (k & 1: upper x, k & 2: upper y,
   // k & 4: upper z); -1 for a leaf.
   std::int32_t children = -1;
   bool empty = true;  // no medium can be in the node
 };
 
+// Bounds are kept per bin: in rgb mode the three channels; in spectral mode kSpectralBins
+// wavelength intervals (render/path_spectra.h), each bounding mu_t over its whole interval, so
+// any wavelength drawn in it is bounded.
 struct MajorantOctree {
   Box box;  // the root's box; empty when there is no medium
   // Half the extent of a node at each level; the build and the walk both place children with it,
   // so they agree on every box to the last bit.
   std::array<Vec3, kOctreeMaxDepth + 1> half{};
   std::vector<OctreeNode> nodes;  // breadth first, nodes[0] the root; empty when no medium
-  int depth = 0;                  // deepest level reached
+  int bins = 3;
+  // Per node, `bins` majorants of mu_t (the majorant scale is applied by the walk), then `bins`
+  // minorants.
+  std::vector<double> bounds;
+  int depth = 0;  // deepest level reached
   double build_seconds = 0;
-  std::size_t bytes() const { return sizeof(MajorantOctree) + nodes.size() * sizeof(OctreeNode); }
+
+  const double* mu_bar(std::size_t node) const { return &bounds[2 * bins * node]; }
+  const double* mu_c(std::size_t node) const { return &bounds[2 * bins * node + bins]; }
+  std::size_t bytes() const {
+    return sizeof(MajorantOctree) + nodes.size() * sizeof(OctreeNode) +
+           bounds.size() * sizeof(double);
+  }
 };
 
 // The octree of the media a ray sees from `inside`: -1 for the field of index-matched objects,
@@ -73,7 +84,7 @@ MajorantOctree build_majorant_octree(const Scene& scene, int inside);
 // Call after the objects, media and tracking settings are final.
 void build_majorant_octrees(Scene& scene);
 
-// Calls leaf(node, a, b) for every non-empty leaf the ray crosses in [t_min, t_max], front to
+// Calls leaf(node index, a, b) for every non-empty leaf the ray crosses in [t_min, t_max], front to
 // back, with [a, b] the ray's stretch inside it; consecutive stretches share their end points
 // exactly. leaf returns false to stop; then so does the walk.
 template <class Leaf>
@@ -98,7 +109,7 @@ bool walk_octree(const MajorantOctree& tree, const Ray& ray, double t_min, doubl
     const Item it = stack[--top];
     const OctreeNode& node = tree.nodes[it.node];
     if (node.children < 0) {
-      if (!node.empty && !leaf(node, it.t0, it.t1)) return false;
+      if (!node.empty && !leaf(it.node, it.t0, it.t1)) return false;
       continue;
     }
     // The ray crosses the three mid-planes in order; between crossings it is in one child.

@@ -18,13 +18,13 @@ double sphere_cos_max(const Light& l, double dist2) {
 std::optional<LightSample> sample_light(const Light& light, const Vec3& p, double u1, double u2) {
   switch (light.type) {
     case Light::Type::Environment:
-      return LightSample{sample_uniform_sphere(u1, u2), kInf, light.radiance, kInv4Pi, false};
+      return LightSample{sample_uniform_sphere(u1, u2), kInf, 1.0, kInv4Pi, false};
     case Light::Type::Directional:
-      return LightSample{-light.direction, kInf, light.irradiance, 0, true};
+      return LightSample{-light.direction, kInf, 1.0, 0, true};
     case Light::Type::Point: {
       const Vec3 d = light.position - p;
       const double d2 = dot(d, d);
-      return LightSample{d / std::sqrt(d2), std::sqrt(d2), light.intensity / d2, 0, true};
+      return LightSample{d / std::sqrt(d2), std::sqrt(d2), 1 / d2, 0, true};
     }
     case Light::Type::Sphere: {
       const Vec3 d = light.center - p;
@@ -36,7 +36,7 @@ std::optional<LightSample> sample_light(const Light& light, const Vec3& p, doubl
       const auto t = intersect_sphere_light(light, {p, wi}, 0, kInf);
       // The cone is tangent to the sphere; a direction at its rim can round to a miss.
       const double dist = t ? *t : std::sqrt(d2 - light.radius * light.radius);
-      return LightSample{wi, dist, light.radiance, 1 / (2 * kPi * (1 - cos_max)), false};
+      return LightSample{wi, dist, 1.0, 1 / (2 * kPi * (1 - cos_max)), false};
     }
   }
   return std::nullopt;

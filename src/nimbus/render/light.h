@@ -6,28 +6,29 @@
 
 #include "nimbus/math/ray.h"
 #include "nimbus/math/vec3.h"
-#include "nimbus/spectral/spectrum.h"
+#include "nimbus/spectral/spectral_param.h"
 
 namespace nimbus {
 
 struct Light {
   enum class Type { Environment, Directional, Point, Sphere };
   Type type = Type::Environment;
-  Rgb radiance{0.0};    // environment, sphere
-  Rgb irradiance{0.0};  // directional: on a plane normal to the beam
-  Rgb intensity{0.0};   // point
+  // Radiance (environment, sphere), irradiance on a plane normal to the beam (directional) or
+  // intensity (point); role Illuminant.
+  SpectralParam emission;
   Vec3 direction;       // directional: the direction light travels (unit)
   Vec3 position;        // point
   Vec3 center;          // sphere
   double radius = 0;    // sphere
 };
 
-// Incident light at p from one sampled direction. pdf is a solid-angle density, or 0 with
-// `delta` set for directional and point lights.
+// Incident light at p from one sampled direction: Li = falloff times the light's emission (at the
+// path's channels). pdf is a solid-angle density, or 0 with `delta` set for directional and point
+// lights.
 struct LightSample {
   Vec3 wi;          // towards the light, unit
   double distance;  // to the emitting point (infinity for distant lights)
-  Rgb Li;
+  double falloff;   // 1 / distance² for a point light, else 1
   double pdf = 0;
   bool delta = false;
 };

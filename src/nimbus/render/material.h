@@ -3,16 +3,16 @@
 // unit vectors; wo points away from the surface towards where the path came from.
 
 #include "nimbus/math/vec3.h"
-#include "nimbus/spectral/spectrum.h"
+#include "nimbus/spectral/spectral_param.h"
 
 namespace nimbus {
 
 struct Surface {
   enum class Type { None, Diffuse, Dielectric, Emissive };
   Type type = Type::Diffuse;
-  Rgb albedo{0.5};
+  SpectralParam albedo{Rgb(0.5)};  // role Albedo
   double ior = 1.5;
-  Rgb radiance{0.0};
+  SpectralParam radiance;  // role Illuminant
 };
 
 // Unpolarised Fresnel reflectance at a smooth interface; eta = n_transmitted / n_incident.

@@ -52,4 +52,17 @@ Vec3 offset_origin(const Scene& scene, const Vec3& p, const Vec3& n, const Vec3&
   return dot(n, w) >= 0 ? p + n * eps : p - n * eps;
 }
 
+void complete_spectra(Scene& scene) {
+  for (Medium& m : scene.media) {
+    complete_spectrum(m.sigma_a, SpectralRole::Unbounded);
+    complete_spectrum(m.sigma_s, SpectralRole::Unbounded);
+    complete_spectrum(m.emission, SpectralRole::Illuminant);
+  }
+  for (SceneObject& obj : scene.objects) {
+    complete_spectrum(obj.surface.albedo, SpectralRole::Albedo);
+    complete_spectrum(obj.surface.radiance, SpectralRole::Illuminant);
+  }
+  for (Light& l : scene.lights) complete_spectrum(l.emission, SpectralRole::Illuminant);
+}
+
 }  // namespace nimbus

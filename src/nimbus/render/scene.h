@@ -33,12 +33,21 @@ struct TrackingSettings {
   int octree_depth = 0;
 };
 
+// rgb: three fixed channels. spectral: `wavelengths` channels sampled per path (docs/spectra.md).
+struct SpectralSettings {
+  enum class Mode { Rgb, Spectral };
+  Mode mode = Mode::Rgb;
+  int wavelengths = 8;  // spectral mode: kMinWavelengths..kMaxWavelengths
+};
+inline constexpr int kMinWavelengths = 4, kMaxWavelengths = 16;
+
 struct RenderSettings {
   int width = 640, height = 480;
   int spp = 16;
   uint64_t seed = 0;
   int max_depth = 1000;
   TrackingSettings tracking;
+  SpectralSettings spectral;
 };
 
 struct SceneObject {
@@ -74,6 +83,10 @@ std::optional<SurfaceHit> intersect(const Scene& scene, const Ray& ray, double t
 // shadow ray aims at (`target_light`, an index into lights, or -1), which would otherwise hide
 // itself from a shadow ray whose origin was offset towards it.
 bool occluded(const Scene& scene, const Ray& ray, double t_max, int target_light = -1);
+
+// Gives every colour input of the scene its spectral curve (spectral_param.h), by role; spectral
+// mode needs them, rgb mode ignores them. Call before build_majorant_octrees.
+void complete_spectra(Scene& scene);
 
 // The outward unit normal of an object at a point on its surface (F decreases outwards).
 Vec3 outward_normal(const SceneObject& object, const Vec3& p);

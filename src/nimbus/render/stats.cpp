@@ -16,6 +16,9 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
   j["spp"] = scene.settings.spp;
   j["seed"] = scene.settings.seed;
   j["threads"] = result.threads;
+  const bool spectral = scene.settings.spectral.mode == SpectralSettings::Mode::Spectral;
+  j["spectrum"] = {{"mode", spectral ? "spectral" : "rgb"},
+                   {"channels", spectral ? scene.settings.spectral.wavelengths : 3}};
   j["wall_seconds"] = result.seconds;
   j["samples_per_second"] = result.seconds > 0 ? samples / result.seconds : 0.0;
   j["image_mean"] = {m.mean[0], m.mean[1], m.mean[2]};

@@ -1,45 +1,199 @@
 #pragma once
 // The integrator's view of the media along a ray: where the next real collision is, and how much
 // light gets through. Both walk the majorant segments of the medium field with the estimators of
-// tracking/ that the scene's tracking settings select (docs/media.md).
+// tracking/ that the scene's tracking settings select (docs/media.md), on a path's N channels.
+
+#include <algorithm>
+#include <cmath>
 
 #include "nimbus/math/rng.h"
 #include "nimbus/media/medium_field.h"
 #include "nimbus/render/counters.h"
+#include "nimbus/render/path_spectra.h"
 #include "nimbus/render/scene.h"
+#include "nimbus/tracking/decomposition_tracking.h"
+#include "nimbus/tracking/delta_tracking.h"
 #include "nimbus/tracking/spectral_mis.h"
+#include "nimbus/tracking/spectral_tracking.h"
+#include "nimbus/tracking/transmittance.h"
 
 namespace nimbus {
 
+template <int N>
 struct MediumEvent {
   enum class Type { None, Scatter, Absorb };
   Type type = Type::None;
   double t = 0;
-  MediumPoint medium;  // the coefficients at the collision
-  Rgb emitted{0.0};    // radiance emitted by the media on the way, already weighted by the path
+  MediumPoint<N> medium;       // the coefficients at the collision
+  Spectrum<N> emitted{0.0};    // radiance emitted by the media on the way, weighted by the path
 };
+
+namespace volume_detail {
+
+template <int N>
+MediumSample<N> as_sample(const MediumPoint<N>& m) {
+  MediumSample<N> s{m.mu_a, m.mu_s, Spectrum<N>(0.0)};
+  for (int c = 0; c < N; ++c) s.L_e[c] = m.mu_a[c] > 0 ? m.mu_a_Le[c] / m.mu_a[c] : 0.0;
+  return s;
+}
+
+// The medium along a ray, keeping the last point looked up: the one at the collision that ends
+// tracking.
+template <int N>
+struct RayLookup {
+  const Scene& scene;
+  const PathSpectra<N>& ps;
+  const Ray& ray;
+  int inside;
+  MediumPoint<N> last;
+  MediumSample<N> operator()(double t) {
+    last = medium_at(scene, ps, ray.at(t), inside);
+    return as_sample(last);
+  }
+};
+
+// Fills in the event of a real collision at t; `at` is the lookup made there.
+template <int N>
+MediumEvent<N> real_event(const Collision& c, const MediumPoint<N>& at, Counters& counters) {
+  MediumEvent<N> ev;
+  ++counters.real_collisions;
+  ev.t = c.t;
+  ev.medium = at;
+  if (c.event == CollisionEvent::Scatter) {
+    ++counters.scatter_events;
+    ev.type = MediumEvent<N>::Type::Scatter;
+  } else {
+    ev.type = MediumEvent<N>::Type::Absorb;
+  }
+  return ev;
+}
+
+}  // namespace volume_detail
 
 // The next real collision over (0, t_max) of the ray (unit direction), for every mode but
 // spectral-mis. `beta`, the path throughput, is updated by the tracking weights.
 // delta: one channel per path; `channel` -1 means none is chosen yet: where the ray meets a
-// medium one is drawn uniformly and returned, and beta keeps that channel only (times 3).
+// medium one is drawn uniformly and returned, and beta keeps that channel only (times N).
 // spectral-max, spectral-history: every channel along one free path; `channel` is unused.
-MediumEvent sample_collision(const Scene& scene, const Ray& ray, double t_max, int inside,
-                             Rgb& beta, int& channel, Rng& rng, Counters& counters);
+template <int N>
+MediumEvent<N> sample_collision(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray,
+                                double t_max, int inside, Spectrum<N>& beta, int& channel,
+                                Rng& rng, Counters& counters) {
+  using Mode = TrackingSettings::Mode;
+  const TrackingSettings& ts = scene.settings.tracking;
+  const bool delta = ts.mode == Mode::Delta;
+  EventPolicy policy;
+  policy.rule = delta                              ? EventRule::Channel
+                : ts.mode == Mode::SpectralHistory ? EventRule::History
+                                                   : EventRule::Max;
+  policy.absorption_events = ts.absorption == TrackingSettings::Absorption::Collide;
+  // The classic baseline: Woodcock's delta tracking, which clamps where mu_bar does not bound.
+  const bool woodcock = delta && policy.absorption_events && !ts.decomposition;
+
+  volume_detail::RayLookup<N> lookup{scene, ps, ray, inside, {}};
+  Spectrum<N> emitted(0.0);
+  MediumEvent<N> ev;
+  walk_majorant_segments(scene, ps.ch, ray, 0, t_max, inside, [&](const MajorantSegment<N>& seg) {
+    ++counters.majorant_segments;
+    // Delta tracking picks its channel where the path first meets a medium and reweights.
+    if (delta && channel < 0) {
+      channel = std::min(N - 1, static_cast<int>(rng.uniform() * N));
+      const double b = beta[channel];
+      beta = Spectrum<N>(0.0);
+      beta[channel] = N * b;
+    }
+    policy.channel = std::max(channel, 0);
+    const double mu_bar = delta ? seg.mu_bar[channel] : seg.mu_bar.max();
+    Collision c;
+    if (woodcock) {
+      c = delta_tracking<N>(lookup, seg.t0, seg.t1, mu_bar, channel, rng, counters.tracking);
+      if (c.event == CollisionEvent::Absorb)
+        emitted = beta * volume_detail::as_sample(lookup.last).L_e;
+    } else if (ts.decomposition) {
+      c = decomposition_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_c.min(), mu_bar, policy, beta,
+                                    emitted, rng, counters.tracking);
+    } else {
+      c = spectral_tracking<N>(lookup, seg.t0, seg.t1, mu_bar, policy, beta, emitted, rng,
+                               counters.tracking);
+    }
+    if (c.event == CollisionEvent::Escape) return true;
+    ev = volume_detail::real_event(c, lookup.last, counters);
+    return false;
+  });
+  ev.emitted = emitted;
+  return ev;
+}
 
 // spectral-mis: the next real collision with hero channel `hero`, updating beta, r_u and r_l.
-MediumEvent sample_collision_mis(const Scene& scene, const Ray& ray, double t_max, int inside,
-                                 int hero, MisPath<3>& path, Rng& rng, Counters& counters);
+template <int N>
+MediumEvent<N> sample_collision_mis(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray,
+                                    double t_max, int inside, int hero, MisPath<N>& path, Rng& rng,
+                                    Counters& counters) {
+  volume_detail::RayLookup<N> lookup{scene, ps, ray, inside, {}};
+  Spectrum<N> emitted(0.0);
+  MediumEvent<N> ev;
+  walk_majorant_segments(scene, ps.ch, ray, 0, t_max, inside, [&](const MajorantSegment<N>& seg) {
+    ++counters.majorant_segments;
+    const Collision c = hero_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_bar, hero, path, emitted,
+                                         rng, counters.tracking);
+    if (c.event == CollisionEvent::Escape) return true;
+    ev = volume_detail::real_event(c, lookup.last, counters);
+    return false;
+  });
+  ev.emitted = emitted;
+  return ev;
+}
 
 // Transmittance over (0, t_max) by ratio or residual ratio tracking (settings.transmittance),
 // and 0 if a surface blocks the way. `light` is the light the shadow ray aims at (it does not
 // block), or -1.
-Rgb transmittance(const Scene& scene, const Ray& ray, double t_max, int light, int inside, Rng& rng,
-                  Counters& counters);
+template <int N>
+Spectrum<N> transmittance(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray,
+                          double t_max, int light, int inside, Rng& rng, Counters& counters) {
+  ++counters.shadow_rays;
+  if (occluded(scene, ray, t_max, light)) return Spectrum<N>(0.0);
+  auto lookup = [&](double t) {
+    return volume_detail::as_sample(medium_at(scene, ps, ray.at(t), inside));
+  };
+  const bool residual =
+      scene.settings.tracking.transmittance == TrackingSettings::Transmittance::ResidualRatio;
+  Spectrum<N> T(1.0);
+  walk_majorant_segments(scene, ps.ch, ray, 0, t_max, inside, [&](const MajorantSegment<N>& seg) {
+    ++counters.majorant_segments;
+    if (residual) {
+      // The residual's rate must bound |mu_t − mu_c|; a scaled majorant may fall below mu_c.
+      double mu_bar_r = 0;
+      for (int c = 0; c < N; ++c)
+        mu_bar_r = std::max(mu_bar_r, std::abs(seg.mu_bar[c] - seg.mu_c[c]));
+      T = residual_ratio_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_c, mu_bar_r, rng,
+                                     counters.tracking, T);
+    } else {
+      T = ratio_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_bar.max(), rng, counters.tracking, T);
+    }
+    return !T.is_black();
+  });
+  return T;
+}
 
 // spectral-mis: the shadow ray's T_ray, r_u and r_l (in `path`, which starts at 1), by hero ratio
 // tracking. False if a surface blocks the way or T_ray became 0.
-bool transmittance_mis(const Scene& scene, const Ray& ray, double t_max, int light, int inside,
-                       int hero, MisPath<3>& path, Rng& rng, Counters& counters);
+template <int N>
+bool transmittance_mis(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray, double t_max,
+                       int light, int inside, int hero, MisPath<N>& path, Rng& rng,
+                       Counters& counters) {
+  ++counters.shadow_rays;
+  if (occluded(scene, ray, t_max, light)) return false;
+  auto lookup = [&](double t) {
+    return volume_detail::as_sample(medium_at(scene, ps, ray.at(t), inside));
+  };
+  bool reaches = true;
+  walk_majorant_segments(scene, ps.ch, ray, 0, t_max, inside, [&](const MajorantSegment<N>& seg) {
+    ++counters.majorant_segments;
+    reaches = hero_ratio_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_bar, hero, path, rng,
+                                     counters.tracking);
+    return reaches;
+  });
+  return reaches;
+}
 
 }  // namespace nimbus

@@ -32,9 +32,9 @@ Light compile_light(const LightDesc& d) {
       l.type = Light::Type::Sphere;
       break;
   }
-  l.radiance = d.radiance;
-  l.irradiance = d.irradiance;
-  l.intensity = d.intensity;
+  l.emission = d.type == LightDesc::Type::Directional ? d.irradiance
+               : d.type == LightDesc::Type::Point     ? d.intensity
+                                                      : d.radiance;
   l.direction = d.type == LightDesc::Type::Directional ? normalize(d.direction) : d.direction;
   l.position = d.position;
   l.center = d.center;
@@ -121,6 +121,9 @@ Scene compile_scene(const SceneDesc& desc) {
   scene.settings.seed = desc.integrator.seed;
   scene.settings.max_depth = desc.integrator.max_depth;
   scene.settings.tracking = compile_tracking(desc.integrator);
+  scene.settings.spectral.mode = desc.spectrum.mode == "spectral" ? SpectralSettings::Mode::Spectral
+                                                                  : SpectralSettings::Mode::Rgb;
+  scene.settings.spectral.wavelengths = desc.spectrum.wavelengths;
   scene.camera = compile_camera(desc.camera, desc.film);
 
   for (const MediumDesc& md : desc.media) scene.media.push_back(compile_medium(md));
@@ -143,11 +146,11 @@ Scene compile_scene(const SceneDesc& desc) {
             ? -1
             : od.medium;
     if (obj.surface.type == Surface::Type::None) {
-      if (scene.field_objects.size() == MediumPoint::kMaxMedia)
+      if (scene.field_objects.size() == kMaxMediaAtPoint)
         throw SceneError(
             fmt::format("{}: {}/medium: at most {} index-matched (surface none) "
                         "medium objects are supported",
-                        desc.source, od.json_path, MediumPoint::kMaxMedia));
+                        desc.source, od.json_path, kMaxMediaAtPoint));
       scene.field_objects.push_back(static_cast<int>(scene.objects.size()));
     }
     all = unite(all, obj.bounds);
@@ -155,6 +158,7 @@ Scene compile_scene(const SceneDesc& desc) {
   }
   for (const LightDesc& ld : desc.lights) scene.lights.push_back(compile_light(ld));
   if (!all.empty()) scene.scale = length(all.extent());
+  complete_spectra(scene);
   build_majorant_octrees(scene);
   return scene;
 }

@@ -12,6 +12,7 @@
 
 #include "nimbus/frep/primitives.h"
 #include "nimbus/media/octree.h"
+#include "nimbus/render/scene.h"
 
 namespace nimbus {
 namespace {
@@ -22,6 +23,41 @@ constexpr double kMinDeterminant = 1e-12;
 
 // In the order of SurfaceDesc::Type, so that an index is the enumerator.
 const std::vector<std::string_view> kSurfaceTypes = {"none", "diffuse", "dielectric", "emissive"};
+
+// A colour input: RGB (one number or [r, g, b]) in `range`, or an object holding a sampled
+// spectrum {"spectrum": [[nm, value], ...]} (values in `range`, nm strictly increasing) or, for
+// emitted light only, a blackbody {"blackbody": kelvin, "scale": luminance}.
+SpectralParam read_colour(const JsonValue& v, SpectralRole role, const Range& range) {
+  if (!v.json().is_object()) return SpectralParam(v.rgb(range));
+  JsonObject o(v);
+  const auto spectrum = o.optional("spectrum");
+  const auto blackbody = role == SpectralRole::Illuminant ? o.optional("blackbody") : std::nullopt;
+  const auto scale = blackbody ? o.optional("scale") : std::nullopt;
+  o.finish(role == SpectralRole::Illuminant ? "(expected \"spectrum\" or \"blackbody\")"
+                                            : "(expected \"spectrum\")");
+  if (spectrum && blackbody) blackbody->fail("give either \"spectrum\" or \"blackbody\", not both");
+  if (blackbody) {
+    const double kelvin = blackbody->number(between(100, 1e6));
+    const double s = scale ? scale->number(at_least(0)) : 1.0;
+    return from_curve(blackbody_spectrum(kelvin, s), role);
+  }
+  if (!spectrum)
+    v.fail(role == SpectralRole::Illuminant
+               ? "expected a number, [r, g, b], {\"spectrum\": ...} or {\"blackbody\": ...}"
+               : "expected a number, [r, g, b] or {\"spectrum\": [[nm, value], ...]}");
+  const std::vector<JsonValue> entries = spectrum->array();
+  if (entries.empty()) spectrum->fail("expected at least one [nm, value] pair");
+  std::vector<std::pair<double, double>> points;
+  for (const JsonValue& e : entries) {
+    if (!e.json().is_array() || e.json().size() != 2) e.fail("expected a pair [nm, value]");
+    const std::vector<JsonValue> pair = e.array();
+    const double nm = pair[0].number(between(1, 100000));
+    if (!points.empty() && !(nm > points.back().first))
+      pair[0].fail(fmt::format("wavelengths must increase (after {} nm)", points.back().first));
+    points.emplace_back(nm, pair[1].number(range));
+  }
+  return from_curve(piecewise_linear_spectrum(std::move(points)), role);
+}
 
 std::string string_choice(const JsonValue& v, std::string_view noun,
                           const std::vector<std::string_view>& names) {
@@ -75,6 +111,7 @@ class Loader {
     const auto film = root_.optional("film");
     const auto camera = root_.optional("camera");
     const auto integrator = root_.optional("integrator");
+    const auto spectrum = root_.optional("spectrum");
     const auto lights = root_.optional("lights");
     const auto shapes = root_.optional("shapes");
     const auto media = root_.optional("media");
@@ -86,6 +123,7 @@ class Loader {
     if (film) scene.film = read_film(*film);
     scene.camera = read_camera(camera ? *camera : root_.required("camera"));
     if (integrator) scene.integrator = read_integrator(*integrator);
+    if (spectrum) scene.spectrum = read_spectrum(*spectrum);
     if (lights)
       for (const JsonValue& l : lights->array()) scene.lights.push_back(read_light(l));
     if (shapes) {
@@ -140,6 +178,16 @@ class Loader {
     return c;
   }
 
+  static SpectrumDesc read_spectrum(const JsonValue& v) {
+    JsonObject o(v);
+    SpectrumDesc d;
+    if (auto x = o.optional("mode")) d.mode = string_choice(*x, "spectrum mode", {"rgb", "spectral"});
+    if (auto x = o.optional("wavelengths"))
+      d.wavelengths = x->integer(between(kMinWavelengths, kMaxWavelengths));
+    o.finish();
+    return d;
+  }
+
   static IntegratorDesc read_integrator(const JsonValue& v) {
     JsonObject o(v);
     IntegratorDesc d;
@@ -181,20 +229,20 @@ class Loader {
     l.type = static_cast<LightDesc::Type>(kind);
     switch (l.type) {
       case LightDesc::Type::Environment:
-        l.radiance = o.required("radiance").rgb(at_least(0));
+        l.radiance = read_colour(o.required("radiance"), SpectralRole::Illuminant, at_least(0));
         break;
       case LightDesc::Type::Directional:
         l.direction = normalize(o.required("direction").direction());
-        l.irradiance = o.required("irradiance").rgb(at_least(0));
+        l.irradiance = read_colour(o.required("irradiance"), SpectralRole::Illuminant, at_least(0));
         break;
       case LightDesc::Type::Point:
         l.position = o.required("position").vec3();
-        l.intensity = o.required("intensity").rgb(at_least(0));
+        l.intensity = read_colour(o.required("intensity"), SpectralRole::Illuminant, at_least(0));
         break;
       case LightDesc::Type::Sphere:
         l.center = o.required("center").vec3();
         l.radius = o.required("radius").number(above(0));
-        l.radiance = o.required("radiance").rgb(at_least(0));
+        l.radiance = read_colour(o.required("radiance"), SpectralRole::Illuminant, at_least(0));
         break;
     }
     o.finish(fmt::format("for light type \"{}\"", type.string()));
@@ -205,9 +253,9 @@ class Loader {
     JsonObject o(v);
     MediumDesc m;
     m.name = name;
-    if (auto x = o.optional("sigma_a")) m.sigma_a = x->rgb(at_least(0));
-    if (auto x = o.optional("sigma_s")) m.sigma_s = x->rgb(at_least(0));
-    if (auto x = o.optional("emission")) m.emission = x->rgb(at_least(0));
+    if (auto x = o.optional("sigma_a")) m.sigma_a = read_colour(*x, SpectralRole::Unbounded, at_least(0));
+    if (auto x = o.optional("sigma_s")) m.sigma_s = read_colour(*x, SpectralRole::Unbounded, at_least(0));
+    if (auto x = o.optional("emission")) m.emission = read_colour(*x, SpectralRole::Illuminant, at_least(0));
     if (auto x = o.optional("phase")) {
       JsonObject p(*x);
       std::string type = "isotropic";
@@ -270,13 +318,13 @@ class Loader {
         case SurfaceDesc::Type::None:
           break;
         case SurfaceDesc::Type::Diffuse:
-          if (auto a = so.optional("albedo")) obj.surface.albedo = a->rgb(between(0, 1));
+          if (auto a = so.optional("albedo")) obj.surface.albedo = read_colour(*a, SpectralRole::Albedo, between(0, 1));
           break;
         case SurfaceDesc::Type::Dielectric:
           if (auto i = so.optional("ior")) obj.surface.ior = i->number(at_least(1));
           break;
         case SurfaceDesc::Type::Emissive:
-          obj.surface.radiance = so.required("radiance").rgb(at_least(0));
+          obj.surface.radiance = read_colour(so.required("radiance"), SpectralRole::Illuminant, at_least(0));
           break;
       }
       so.finish(fmt::format("for surface type \"{}\"",

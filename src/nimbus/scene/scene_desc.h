@@ -9,7 +9,7 @@
 
 #include "nimbus/frep/shape_desc.h"
 #include "nimbus/math/vec3.h"
-#include "nimbus/spectral/spectrum.h"
+#include "nimbus/spectral/spectral_param.h"
 
 namespace nimbus {
 
@@ -43,12 +43,20 @@ struct IntegratorDesc {
   } octree;
 };
 
+// How colours are carried (docs/spectra.md): "rgb" or "spectral" with `wavelengths` per path.
+struct SpectrumDesc {
+  std::string mode = "rgb";  // rgb | spectral
+  int wavelengths = 8;       // spectral: 4..16
+};
+
+// Colour inputs are SpectralParam: RGB (a number or [r, g, b]) or a curve from the file
+// ({"spectrum": [[nm, value], ...]}, or {"blackbody": K, "scale": s} where light is emitted).
 struct LightDesc {
   enum class Type { Environment, Directional, Point, Sphere };
   Type type = Type::Environment;
-  Rgb radiance;    // environment, sphere
-  Rgb irradiance;  // directional
-  Rgb intensity;   // point
+  SpectralParam radiance;    // environment, sphere
+  SpectralParam irradiance;  // directional
+  SpectralParam intensity;   // point
   Vec3 direction;  // directional: the direction the light travels, unit length
   Vec3 position;   // point
   Vec3 center;     // sphere
@@ -75,7 +83,7 @@ struct DensityDesc {
 
 struct MediumDesc {
   std::string name;
-  Rgb sigma_a, sigma_s, emission;
+  SpectralParam sigma_a, sigma_s, emission;
   PhaseDesc phase;
   DensityDesc density;
 };
@@ -83,9 +91,9 @@ struct MediumDesc {
 struct SurfaceDesc {
   enum class Type { None, Diffuse, Dielectric, Emissive };
   Type type = Type::Diffuse;
-  Rgb albedo{0.5};   // diffuse
-  double ior = 1.5;  // dielectric
-  Rgb radiance;      // emissive
+  SpectralParam albedo{Rgb(0.5)};  // diffuse
+  double ior = 1.5;                // dielectric
+  SpectralParam radiance;          // emissive
 };
 
 struct ObjectDesc {
@@ -101,6 +109,7 @@ struct SceneDesc {
   FilmDesc film;
   CameraDesc camera;
   IntegratorDesc integrator;
+  SpectrumDesc spectrum;
   std::vector<LightDesc> lights;
   std::vector<MediumDesc> media;
   std::vector<ObjectDesc> objects;

@@ -1,0 +1,86 @@
+#pragma once
+// What a path's N channels are (docs/spectra.md): in rgb mode the three RGB channels; in spectral
+// mode N wavelengths drawn for the path. Each path evaluates the media's coefficients at its
+// channels once, so the tracking estimators see plain Spectrum<N> values either way and run
+// unchanged; the film turns a path's channels into linear sRGB.
+
+#include <algorithm>
+#include <array>
+#include <vector>
+
+#include "nimbus/render/scene.h"
+#include "nimbus/spectral/cie.h"
+#include "nimbus/spectral/color.h"
+#include "nimbus/spectral/spectral_param.h"
+#include "nimbus/spectral/spectrum.h"
+#include "nimbus/spectral/wavelengths.h"
+
+namespace nimbus {
+
+template <int N>
+struct Channels {
+  bool spectral = false;
+  SampledWavelengths<N> wl;  // spectral mode
+  std::array<int, N> bin{};  // the majorant octree's bin holding each channel
+};
+
+// A colour input at the path's channels.
+template <int N>
+Spectrum<N> evaluate(const SpectralParam& p, const Channels<N>& ch) {
+  Spectrum<N> s;
+  if constexpr (N == 3) {
+    if (!ch.spectral) return p.rgb;
+  }
+  for (int i = 0; i < N; ++i) s[i] = (*p.curve)(ch.wl.lambda[i]);
+  return s;
+}
+
+template <int N>
+struct MediumCoefficients {
+  Spectrum<N> sigma_a, sigma_s, emission;
+};
+
+template <int N>
+struct PathSpectra {
+  Channels<N> ch;
+  std::vector<MediumCoefficients<N>> media;  // indexed as scene.media
+};
+
+// The octree's bins in spectral mode: kSpectralBins intervals of equal probability under the
+// wavelength pdf, so a channel drawn from stratified number u lies in bin ⌊u · kSpectralBins⌋.
+inline constexpr int kSpectralBins = 16;
+
+// Sets up ps for a path of `scene`: in rgb mode the RGB channels (u unused); in spectral mode
+// N wavelengths from the uniform number u. Reuses ps's storage.
+template <int N>
+void prepare_path_spectra(PathSpectra<N>& ps, const Scene& scene, double u) {
+  ps.ch.spectral = scene.settings.spectral.mode == SpectralSettings::Mode::Spectral;
+  if (ps.ch.spectral) {
+    ps.ch.wl = sample_wavelengths<N>(u);
+    for (int i = 0; i < N; ++i)
+      ps.ch.bin[i] = std::min(kSpectralBins - 1, static_cast<int>(ps.ch.wl.u[i] * kSpectralBins));
+  } else {
+    for (int i = 0; i < N; ++i) ps.ch.bin[i] = i;
+  }
+  ps.media.resize(scene.media.size());
+  for (size_t m = 0; m < scene.media.size(); ++m) {
+    const Medium& med = scene.media[m];
+    ps.media[m] = {evaluate(med.sigma_a, ps.ch), evaluate(med.sigma_s, ps.ch),
+                   evaluate(med.emission, ps.ch)};
+  }
+}
+
+// A path's radiance at its channels as linear sRGB: itself in rgb mode; in spectral mode the
+// estimate XYZ = (1/N) Σ_i L_i (x̄, ȳ, z̄)(λ_i) / (p(λ_i) ∫ȳ), converted to linear sRGB.
+template <int N>
+Rgb to_film_rgb(const Spectrum<N>& L, const Channels<N>& ch) {
+  if constexpr (N == 3) {
+    if (!ch.spectral) return L;
+  }
+  Vec3 xyz;
+  for (int i = 0; i < N; ++i)
+    if (L[i] != 0) xyz += cie_xyz_bar(ch.wl.lambda[i]) * (L[i] / ch.wl.pdf[i]);
+  return xyz_to_linear_srgb(xyz * (1.0 / (N * cie_y_integral())));
+}
+
+}  // namespace nimbus
