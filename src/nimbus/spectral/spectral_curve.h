@@ -23,15 +23,18 @@ struct SpectralCurve {
   double kelvin = 0;                               // Blackbody: temperature
   bool illuminant = false;                         // times d65_illuminant(λ)
 
-  // The value at λ. PiecewiseLinear holds its end values beyond its first and last points.
+  // The value at λ. PiecewiseLinear holds its end values beyond its first and last points; the
+  // Blackbody shape is Planck's law divided by its value at Wien's peak.
   double operator()(double lambda) const;
-  // Exact lower and upper bounds of the value over [lo, hi] nm (for majorants).
+  // Exact lower and upper bounds of the value over [lo, hi] nm (for majorants). With
+  // `illuminant`, the product of the curve's and D65's exact bounds: safe, possibly loose.
   std::pair<double, double> range(double lo, double hi) const;
 };
 
 SpectralCurve constant_spectrum(double value);
 // rgb in [0, 1]³: a curve in [0, 1] whose reflectance_to_rgb is rgb (within the table's error).
-// Grey (r = g = b) gives the constant exactly.
+// Grey (r = g = b) gives the constant exactly. Components are clamped into [0, 1]; a largest
+// component below 1/2 gives the curve at 1/2 scaled down (docs/spectra.md).
 SpectralCurve rgb_albedo_spectrum(const Rgb& rgb);
 // rgb >= 0: scale 2·max(rgb) times the albedo curve of rgb / scale. Grey gives the constant.
 SpectralCurve rgb_unbounded_spectrum(const Rgb& rgb);
