@@ -296,7 +296,7 @@ std::vector<BadScene> bad_scenes() {
       {"blackbody too cold",
        with_camera(R"("lights": [{"type": "environment", "radiance": {"blackbody": 5}}])"),
        {},
-       "scene.json: /lights/0/radiance/blackbody: must be in [100, 1e+06]"},
+       "scene.json: /lights/0/radiance/blackbody: must be in [100, 1000000]"},
       {"spectrum and blackbody",
        with_camera(
            R"("lights": [{"type": "environment", "radiance": {"blackbody": 5000, "spectrum": [[500, 1]]}}])"),
