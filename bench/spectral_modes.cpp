@@ -42,10 +42,14 @@ int main(int argc, char** argv) {
   std::string scene_path = std::string(NIMBUS_SOURCE_DIR) + "/scenes/cloud.json";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--spp" && i + 1 < argc) spp = std::stoi(argv[++i]);
-    else if (a == "--reps" && i + 1 < argc) reps = std::stoi(argv[++i]);
-    else if (a == "--width" && i + 1 < argc) width = std::stoi(argv[++i]);
-    else scene_path = a;
+    if (a == "--spp" && i + 1 < argc)
+      spp = std::stoi(argv[++i]);
+    else if (a == "--reps" && i + 1 < argc)
+      reps = std::stoi(argv[++i]);
+    else if (a == "--width" && i + 1 < argc)
+      width = std::stoi(argv[++i]);
+    else
+      scene_path = a;
   }
   std::vector<Mode> modes = {
       {"rgb", {"spectrum.mode=\"rgb\""}, {}},
@@ -73,7 +77,9 @@ int main(int argc, char** argv) {
     }
   std::printf("%s, %d spp, width %d, tracking %s, %d repetitions (medians), 1 thread\n\n",
               scene_path.c_str(), spp, width, tracking.c_str(), reps);
-  std::printf("| mode | µs / sample | × rgb | variance / sample (R, G, B) | noise at equal time (R, G, B) × rgb |\n");
+  std::printf(
+      "| mode | µs / sample | × rgb | variance / sample (R, G, B) | noise at equal time (R, G, B) "
+      "× rgb |\n");
   std::printf("|---|---|---|---|---|\n");
   const double t_rgb = median(modes[0].seconds_per_sample);
   for (const Mode& m : modes) {

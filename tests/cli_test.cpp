@@ -206,9 +206,10 @@ TEST_F(Cli, RendersDefaultOutputsAndStats) {
 
 TEST_F(Cli, RendersInSpectralModeFromTheCommandLine) {
   write("scene.json", good_scene().dump());
-  const Outcome r = run(
-      "render scene.json --stats stats.json --set film.width=8 --spp 2 --set spectrum.mode=spectral "
-      "--set spectrum.wavelengths=6 -o s.exr --quiet");
+  const Outcome r =
+      run("render scene.json --stats stats.json --set film.width=8 --spp 2 --set "
+          "spectrum.mode=spectral "
+          "--set spectrum.wavelengths=6 -o s.exr --quiet");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir_ / "s.exr"));
   std::ifstream f(dir_ / "stats.json");
@@ -217,10 +218,12 @@ TEST_F(Cli, RendersInSpectralModeFromTheCommandLine) {
   EXPECT_EQ(s["spectrum"]["channels"], 6);
   for (int c = 0; c < 3; ++c) EXPECT_GT(s["image_mean"][c].get<double>(), 0);
   // A wavelength count out of range is a scene error: exit 2, one line, no output.
-  const Outcome bad = run("render scene.json --set spectrum.mode=spectral "
-                          "--set spectrum.wavelengths=32 -o bad.exr");
+  const Outcome bad =
+      run("render scene.json --set spectrum.mode=spectral "
+          "--set spectrum.wavelengths=32 -o bad.exr");
   EXPECT_EQ(bad.code, 2);
-  EXPECT_NE(bad.err.find("/spectrum/wavelengths: must be in [4, 16]"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("/spectrum/wavelengths: must be in [4, 16]"), std::string::npos)
+      << bad.err;
   EXPECT_FALSE(fs::exists(dir_ / "bad.exr"));
 }
 

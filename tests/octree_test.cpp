@@ -78,8 +78,8 @@ Vec3 point_in(const Box& box, Rng& rng) {
   return p;
 }
 
-// Calls f(node index, level) for the nodes from the root down to the leaf holding p, choosing children
-// as the walk does.
+// Calls f(node index, level) for the nodes from the root down to the leaf holding p, choosing
+// children as the walk does.
 template <class F>
 void descend(const MajorantOctree& tree, const Vec3& p, F&& f) {
   Vec3 center = tree.box.center();
@@ -274,9 +274,9 @@ TEST(Octree, DepthZeroIsOneNodeAndDeepTreesStayBounded) {
   const Scene deep = three_media(kOctreeMaxDepth);
   EXPECT_LE(deep.field_octree.nodes.size(), kOctreeMaxNodes);
   EXPECT_GE(deep.field_octree.depth, 5);
-  EXPECT_EQ(deep.field_octree.bytes(),
-            sizeof(MajorantOctree) + deep.field_octree.nodes.size() * sizeof(OctreeNode) +
-                deep.field_octree.nodes.size() * 2 * 3 * sizeof(double));
+  EXPECT_EQ(deep.field_octree.bytes(), sizeof(MajorantOctree) +
+                                           deep.field_octree.nodes.size() * sizeof(OctreeNode) +
+                                           deep.field_octree.nodes.size() * 2 * 3 * sizeof(double));
 }
 
 TEST(Octree, ASmallDenseFeatureIsRefinedToTheFullDepth) {

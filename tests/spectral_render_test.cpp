@@ -87,8 +87,8 @@ TEST_P(SpectralRender, WhiteFurnace) {
   m.sigma_s = Rgb({1.0, 3.0, 6.0});
   m.g = 0.4;
   scene.media.push_back(m);
-  scene.objects.push_back(test::object_of(make_shape(QuadricNode{sphere({0, 0, 0}, 1)}),
-                                          Surface::Type::None, 0));
+  scene.objects.push_back(
+      test::object_of(make_shape(QuadricNode{sphere({0, 0, 0}, 1)}), Surface::Type::None, 0));
   scene.lights.push_back(test::environment(1.0));
   test::finish_media(scene);
   const Rgb ref = film_value([&](double l) { return d65_illuminant(l); });
@@ -173,8 +173,8 @@ Scene grey_scene(const SpectralSettings& spectrum) {
   cloud.density = Medium::Density::Cloud;
   cloud.cloud = make_cloud_density(CloudParams{});
   scene.media.push_back(cloud);
-  scene.objects.push_back(test::object_of(make_shape(QuadricNode{sphere({0, 0.2, 0}, 1)}),
-                                          Surface::Type::None, 0));
+  scene.objects.push_back(
+      test::object_of(make_shape(QuadricNode{sphere({0, 0.2, 0}, 1)}), Surface::Type::None, 0));
   SceneObject floor = test::object_of(box({-3, -1.1, -3}, {3, -1, 3}), Surface::Type::Diffuse, -1);
   floor.surface.albedo = Rgb(0.6);
   scene.objects.push_back(std::move(floor));

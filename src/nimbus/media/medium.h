@@ -11,7 +11,7 @@ struct Medium {
   enum class Density { Constant, Field, Cloud };
   SpectralParam sigma_a, sigma_s;  // coefficients (role Unbounded)
   SpectralParam emission;          // L_e, entering the RTE as mu_a L_e (eq. 4) (role Illuminant)
-  double g = 0;       // Henyey–Greenstein asymmetry; 0 is isotropic
+  double g = 0;                    // Henyey–Greenstein asymmetry; 0 is isotropic
   Density density = Density::Constant;
   double scale = 1;    // multiplies every density model
   CloudDensity cloud;  // Cloud: density from F and noise

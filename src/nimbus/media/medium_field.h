@@ -92,32 +92,32 @@ struct MajorantSegment {
 // no medium can be there is a gap; neighbouring leaves with identical bounds become one segment.
 // f returns false to stop the walk. The ray direction must be unit length.
 template <int N, class F>
-void walk_majorant_segments(const Scene& scene, const Channels<N>& ch, const Ray& ray,
-                            double t_min, double t_max, int inside, F&& f) {
+void walk_majorant_segments(const Scene& scene, const Channels<N>& ch, const Ray& ray, double t_min,
+                            double t_max, int inside, F&& f) {
   if (inside >= 0 && scene.objects[inside].medium < 0) return;  // a solid without a medium
   // at(): a scene whose octrees were never built fails loudly rather than reading past the end.
   const MajorantOctree& tree = inside >= 0 ? scene.solid_octrees.at(inside) : scene.field_octree;
   const double scale = scene.settings.tracking.majorant_scale;
   MajorantSegment<N> pending{0, 0, Spectrum<N>(0.0), Spectrum<N>(0.0)};
   bool has_pending = false;
-  const bool finished = walk_octree(tree, ray, t_min, t_max, [&](std::int32_t node, double a,
-                                                                 double b) {
-    const double* hi = tree.mu_bar(node);
-    const double* lo = tree.mu_c(node);
-    Spectrum<N> mu_bar, mu_c;
-    for (int c = 0; c < N; ++c) {
-      mu_bar[c] = hi[ch.bin[c]] * scale;
-      mu_c[c] = lo[ch.bin[c]];
-    }
-    if (has_pending && a == pending.t1 && mu_bar == pending.mu_bar && mu_c == pending.mu_c) {
-      pending.t1 = b;
-      return true;
-    }
-    if (has_pending && !f(std::as_const(pending))) return false;
-    pending = {a, b, mu_bar, mu_c};
-    has_pending = true;
-    return true;
-  });
+  const bool finished =
+      walk_octree(tree, ray, t_min, t_max, [&](std::int32_t node, double a, double b) {
+        const double* hi = tree.mu_bar(node);
+        const double* lo = tree.mu_c(node);
+        Spectrum<N> mu_bar, mu_c;
+        for (int c = 0; c < N; ++c) {
+          mu_bar[c] = hi[ch.bin[c]] * scale;
+          mu_c[c] = lo[ch.bin[c]];
+        }
+        if (has_pending && a == pending.t1 && mu_bar == pending.mu_bar && mu_c == pending.mu_c) {
+          pending.t1 = b;
+          return true;
+        }
+        if (has_pending && !f(std::as_const(pending))) return false;
+        pending = {a, b, mu_bar, mu_c};
+        has_pending = true;
+        return true;
+      });
   if (finished && has_pending) f(std::as_const(pending));
 }
 

@@ -35,7 +35,8 @@ std::vector<std::vector<double>> sigma_t_bins(const Scene& scene, int bins) {
         continue;
       }
       const double lo = sample_visible_wavelength(double(b) / bins);
-      const double hi = b + 1 == bins ? kLambdaMax : sample_visible_wavelength(double(b + 1) / bins);
+      const double hi =
+          b + 1 == bins ? kLambdaMax : sample_visible_wavelength(double(b + 1) / bins);
       const auto [a_lo, a_hi] = m.sigma_a.curve->range(lo, hi);
       const auto [s_lo, s_hi] = m.sigma_s.curve->range(lo, hi);
       v[b] = a_hi + s_hi;
@@ -150,9 +151,10 @@ Grown prune(Grown g, const MajorantOctree& tree) {
   std::vector<double> cost(g.nodes.size());
   for (size_t i = g.nodes.size(); i-- > 0;) {
     OctreeNode& n = g.nodes[i];
-    const double leaf = n.empty ? 1.0
-                                : 1.0 + kOctreeLookupCost * null_rate(&g.bounds[2 * bins * i], bins) *
-                                            mean_chord(tree.half[g.levels[i]]);
+    const double leaf = n.empty
+                            ? 1.0
+                            : 1.0 + kOctreeLookupCost * null_rate(&g.bounds[2 * bins * i], bins) *
+                                        mean_chord(tree.half[g.levels[i]]);
     cost[i] = leaf;
     if (n.children < 0) continue;
     double split = 0;
@@ -249,8 +251,7 @@ MajorantOctree build_majorant_octree(const Scene& scene, int inside) {
   const auto start = std::chrono::steady_clock::now();
   const TrackingSettings& settings = scene.settings.tracking;
   MajorantOctree tree;
-  tree.bins =
-      scene.settings.spectral.mode == SpectralSettings::Mode::Spectral ? kSpectralBins : 3;
+  tree.bins = scene.settings.spectral.mode == SpectralSettings::Mode::Spectral ? kSpectralBins : 3;
   const int bins = tree.bins;
   const std::vector<std::vector<double>> sigma_t = sigma_t_bins(scene, bins);
   auto member = [&](const SceneObject& obj) {

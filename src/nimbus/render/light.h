@@ -16,10 +16,10 @@ struct Light {
   // Radiance (environment, sphere), irradiance on a plane normal to the beam (directional) or
   // intensity (point); role Illuminant.
   SpectralParam emission;
-  Vec3 direction;       // directional: the direction light travels (unit)
-  Vec3 position;        // point
-  Vec3 center;          // sphere
-  double radius = 0;    // sphere
+  Vec3 direction;     // directional: the direction light travels (unit)
+  Vec3 position;      // point
+  Vec3 center;        // sphere
+  double radius = 0;  // sphere
 };
 
 // Incident light at p from one sampled direction: Li = falloff times the light's emission (at the

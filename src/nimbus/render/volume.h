@@ -24,8 +24,8 @@ struct MediumEvent {
   enum class Type { None, Scatter, Absorb };
   Type type = Type::None;
   double t = 0;
-  MediumPoint<N> medium;       // the coefficients at the collision
-  Spectrum<N> emitted{0.0};    // radiance emitted by the media on the way, weighted by the path
+  MediumPoint<N> medium;     // the coefficients at the collision
+  Spectrum<N> emitted{0.0};  // radiance emitted by the media on the way, weighted by the path
 };
 
 namespace volume_detail {
@@ -77,8 +77,8 @@ MediumEvent<N> real_event(const Collision& c, const MediumPoint<N>& at, Counters
 // spectral-max, spectral-history: every channel along one free path; `channel` is unused.
 template <int N>
 MediumEvent<N> sample_collision(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray,
-                                double t_max, int inside, Spectrum<N>& beta, int& channel,
-                                Rng& rng, Counters& counters) {
+                                double t_max, int inside, Spectrum<N>& beta, int& channel, Rng& rng,
+                                Counters& counters) {
   using Mode = TrackingSettings::Mode;
   const TrackingSettings& ts = scene.settings.tracking;
   const bool delta = ts.mode == Mode::Delta;

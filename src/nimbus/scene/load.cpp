@@ -181,7 +181,8 @@ class Loader {
   static SpectrumDesc read_spectrum(const JsonValue& v) {
     JsonObject o(v);
     SpectrumDesc d;
-    if (auto x = o.optional("mode")) d.mode = string_choice(*x, "spectrum mode", {"rgb", "spectral"});
+    if (auto x = o.optional("mode"))
+      d.mode = string_choice(*x, "spectrum mode", {"rgb", "spectral"});
     if (auto x = o.optional("wavelengths"))
       d.wavelengths = x->integer(between(kMinWavelengths, kMaxWavelengths));
     o.finish();
@@ -253,9 +254,12 @@ class Loader {
     JsonObject o(v);
     MediumDesc m;
     m.name = name;
-    if (auto x = o.optional("sigma_a")) m.sigma_a = read_colour(*x, SpectralRole::Unbounded, at_least(0));
-    if (auto x = o.optional("sigma_s")) m.sigma_s = read_colour(*x, SpectralRole::Unbounded, at_least(0));
-    if (auto x = o.optional("emission")) m.emission = read_colour(*x, SpectralRole::Illuminant, at_least(0));
+    if (auto x = o.optional("sigma_a"))
+      m.sigma_a = read_colour(*x, SpectralRole::Unbounded, at_least(0));
+    if (auto x = o.optional("sigma_s"))
+      m.sigma_s = read_colour(*x, SpectralRole::Unbounded, at_least(0));
+    if (auto x = o.optional("emission"))
+      m.emission = read_colour(*x, SpectralRole::Illuminant, at_least(0));
     if (auto x = o.optional("phase")) {
       JsonObject p(*x);
       std::string type = "isotropic";
@@ -318,13 +322,15 @@ class Loader {
         case SurfaceDesc::Type::None:
           break;
         case SurfaceDesc::Type::Diffuse:
-          if (auto a = so.optional("albedo")) obj.surface.albedo = read_colour(*a, SpectralRole::Albedo, between(0, 1));
+          if (auto a = so.optional("albedo"))
+            obj.surface.albedo = read_colour(*a, SpectralRole::Albedo, between(0, 1));
           break;
         case SurfaceDesc::Type::Dielectric:
           if (auto i = so.optional("ior")) obj.surface.ior = i->number(at_least(1));
           break;
         case SurfaceDesc::Type::Emissive:
-          obj.surface.radiance = read_colour(so.required("radiance"), SpectralRole::Illuminant, at_least(0));
+          obj.surface.radiance =
+              read_colour(so.required("radiance"), SpectralRole::Illuminant, at_least(0));
           break;
       }
       so.finish(fmt::format("for surface type \"{}\"",

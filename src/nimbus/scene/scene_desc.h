@@ -57,9 +57,9 @@ struct LightDesc {
   SpectralParam radiance;    // environment, sphere
   SpectralParam irradiance;  // directional
   SpectralParam intensity;   // point
-  Vec3 direction;  // directional: the direction the light travels, unit length
-  Vec3 position;   // point
-  Vec3 center;     // sphere
+  Vec3 direction;            // directional: the direction the light travels, unit length
+  Vec3 position;             // point
+  Vec3 center;               // sphere
   double radius = 0;
 };
 

@@ -17,11 +17,11 @@ namespace nimbus {
 struct SpectralCurve {
   enum class Type { Constant, Sigmoid, PiecewiseLinear, Blackbody };
   Type type = Type::Constant;
-  double scale = 1;                                // multiplies the shape below
-  double c0 = 0, c1 = 0, c2 = 0;                   // Sigmoid: the quadratic in λ (nm)
-  std::vector<std::pair<double, double>> points;   // PiecewiseLinear: (nm, value), increasing nm
-  double kelvin = 0;                               // Blackbody: temperature
-  bool illuminant = false;                         // times d65_illuminant(λ)
+  double scale = 1;                               // multiplies the shape below
+  double c0 = 0, c1 = 0, c2 = 0;                  // Sigmoid: the quadratic in λ (nm)
+  std::vector<std::pair<double, double>> points;  // PiecewiseLinear: (nm, value), increasing nm
+  double kelvin = 0;                              // Blackbody: temperature
+  bool illuminant = false;                        // times d65_illuminant(λ)
 
   // The value at λ. PiecewiseLinear holds its end values beyond its first and last points; the
   // Blackbody shape is Planck's law divided by its value at Wien's peak.

@@ -11,8 +11,8 @@
 namespace nimbus {
 
 inline constexpr double kLambdaMin = 360.0, kLambdaMax = 830.0;  // nm
-inline constexpr double kVisibleMu = 538.0;                       // nm, where p peaks
-inline constexpr double kVisibleA = 0.0072;                       // 1/nm, the peak's width
+inline constexpr double kVisibleMu = 538.0;                      // nm, where p peaks
+inline constexpr double kVisibleA = 0.0072;                      // 1/nm, the peak's width
 
 // p(λ) over [kLambdaMin, kLambdaMax] (integrates to 1 there; 0 outside).
 double visible_wavelength_pdf(double lambda);
