@@ -30,15 +30,9 @@ struct ModeCase {
 };
 
 TrackingSettings tracking_of(const ModeCase& c) {
-  TrackingSettings t;
-  t.mode = c.mode;
-  t.absorption = c.absorption;
-  t.decomposition = c.decomposition;
-  // Shadow rays: residual ratio tracking with decomposition, ratio tracking without.
-  t.transmittance = c.decomposition ? TrackingSettings::Transmittance::ResidualRatio
-                                    : TrackingSettings::Transmittance::Ratio;
+  TrackingSettings t =
+      test::tracking_settings(c.mode, c.absorption, c.decomposition, c.octree_depth);
   t.majorant_scale = c.majorant_scale;
-  t.octree_depth = c.octree_depth;
   if (c.sampled_majorant) {
     t.majorant_source = TrackingSettings::MajorantSource::Sample;
     t.majorant_samples = 64;  // few, so that some leaves' majorants miss the maximum

@@ -15,14 +15,7 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-// ∫_a^b f by composite Simpson with n (even) intervals.
-template <class F>
-double simpson(F&& f, double a, double b, int n) {
-  const double h = (b - a) / n;
-  double s = f(a) + f(b);
-  for (int i = 1; i < n; ++i) s += (i % 2 ? 4 : 2) * f(a + i * h);
-  return s * h / 3;
-}
+using test::simpson;
 
 TEST(Phase, IsotropicIsOneOverFourPi) {
   for (double c : {-1.0, -0.3, 0.0, 0.8, 1.0}) EXPECT_DOUBLE_EQ(hg_phase(c, 0), kInv4Pi);

@@ -36,14 +36,7 @@ struct SpectralCase {
 };
 
 TrackingSettings tracking_of(const SpectralCase& c) {
-  TrackingSettings t;
-  t.mode = c.mode;
-  t.absorption = c.absorption;
-  t.decomposition = c.decomposition;
-  t.transmittance = c.decomposition ? TrackingSettings::Transmittance::ResidualRatio
-                                    : TrackingSettings::Transmittance::Ratio;
-  t.octree_depth = 4;
-  return t;
+  return test::tracking_settings(c.mode, c.absorption, c.decomposition, 4);
 }
 
 std::string case_name(const testing::TestParamInfo<SpectralCase>& info) {
@@ -160,10 +153,8 @@ INSTANTIATE_TEST_SUITE_P(Modes, SpectralRender, testing::ValuesIn(spectral_cases
 // in rgb and spectral modes: every spectrum in it is a constant or D65 times one.
 Scene grey_scene(const SpectralSettings& spectrum) {
   Scene scene;
-  TrackingSettings t;
-  t.mode = Mode::SpectralMis;
-  t.absorption = Absorption::Collide;
-  t.octree_depth = 4;
+  const TrackingSettings t =
+      test::tracking_settings(Mode::SpectralMis, Absorption::Collide, false, 4);
   scene.settings = {8, 8, 512, 11, 100000, t, {}};
   scene.settings.spectral = spectrum;
   scene.camera = perspective_camera({0, 1.2, 4}, {0, 0, 0}, {0, 1, 0}, 45, 8, 8);

@@ -21,14 +21,7 @@
 namespace nimbus {
 namespace {
 
-// ∫_a^b f by composite Simpson with n (even) intervals.
-template <class F>
-double simpson(F&& f, double a, double b, int n) {
-  const double h = (b - a) / n;
-  double s = f(a) + f(b);
-  for (int i = 1; i < n; ++i) s += (i % 2 ? 4 : 2) * f(a + i * h);
-  return s * h / 3;
-}
+using test::simpson;
 
 double max_abs_diff(const Rgb& a, const Rgb& b) {
   return std::max({std::abs(a[0] - b[0]), std::abs(a[1] - b[1]), std::abs(a[2] - b[2])});

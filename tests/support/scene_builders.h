@@ -26,6 +26,21 @@ inline SceneObject object_of(const ShapePtr& shape, Surface::Type surface, int m
   return obj;
 }
 
+// Tracking settings for a mode; shadow rays use residual ratio tracking with decomposition and
+// ratio tracking without.
+inline TrackingSettings tracking_settings(TrackingSettings::Mode mode,
+                                          TrackingSettings::Absorption absorption,
+                                          bool decomposition, int octree_depth) {
+  TrackingSettings t;
+  t.mode = mode;
+  t.absorption = absorption;
+  t.decomposition = decomposition;
+  t.transmittance = decomposition ? TrackingSettings::Transmittance::ResidualRatio
+                                  : TrackingSettings::Transmittance::Ratio;
+  t.octree_depth = octree_depth;
+  return t;
+}
+
 // Field objects, spectra and majorant octrees, as compile_scene derives them.
 inline void finish_media(Scene& scene) {
   for (size_t i = 0; i < scene.objects.size(); ++i)

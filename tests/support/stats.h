@@ -7,6 +7,15 @@
 
 namespace nimbus::test {
 
+// ∫_a^b f by composite Simpson with n (even) intervals.
+template <class F>
+double simpson(F&& f, double a, double b, int n) {
+  const double h = (b - a) / n;
+  double s = f(a) + f(b);
+  for (int i = 1; i < n; ++i) s += (i % 2 ? 4 : 2) * f(a + i * h);
+  return s * h / 3;
+}
+
 // Running mean and variance (Welford 1962).
 struct MeanVar {
   uint64_t n = 0;
