@@ -13,6 +13,7 @@
 #include "nimbus/frep/tape.h"
 #include "nimbus/math/rng.h"
 #include "nimbus/media/medium_field.h"
+#include "nimbus/render/path_spectra.h"
 #include "nimbus/render/scene.h"
 
 namespace nimbus {
@@ -126,6 +127,39 @@ TEST(Octree, ConservativeBoundsContainMuTAtRandomPoints) {
   EXPECT_GT(inside_medium, 2000);
   EXPECT_GT(checked, 40000);
   EXPECT_GT(deep, 1000) << "the tree should refine where the media vary";
+}
+
+// In spectral mode the tree holds bounds per wavelength bin; every wavelength a path can draw
+// is bounded by its bin's, at every level.
+TEST(Octree, SpectralBinsBoundMuTAtTheSampledWavelengths) {
+  Scene scene = three_media(6);
+  scene.settings.spectral = {SpectralSettings::Mode::Spectral, 8};
+  complete_spectra(scene);
+  build_majorant_octrees(scene);
+  const MajorantOctree& tree = scene.field_octree;
+  ASSERT_EQ(tree.bins, kSpectralBins);
+  ASSERT_GE(tree.depth, 4);
+  Rng rng(4);
+  PathSpectra<8> ps;
+  int inside_medium = 0;
+  for (int i = 0; i < 4000; ++i) {
+    prepare_path_spectra(ps, scene, rng.uniform());
+    const Vec3 p = point_in(tree.box, rng);
+    const Spectrum<8> mu = medium_at(scene, ps, p, -1).mu_t();
+    inside_medium += mu.max() > 0;
+    descend(tree, p, [&](int index, int level) {
+      if (tree.nodes[index].empty) {
+        EXPECT_EQ(mu.max(), 0.0) << "an empty node holds medium at level " << level;
+        return;
+      }
+      for (int c = 0; c < 8; ++c) {
+        const int b = ps.ch.bin[c];
+        EXPECT_LE(tree.mu_c(index)[b], mu[c]) << "level " << level << " λ " << ps.ch.wl.lambda[c];
+        EXPECT_GE(tree.mu_bar(index)[b], mu[c]) << "level " << level << " λ " << ps.ch.wl.lambda[c];
+      }
+    });
+  }
+  EXPECT_GT(inside_medium, 800);
 }
 
 struct Walked {
