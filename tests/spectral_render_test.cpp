@@ -16,6 +16,7 @@
 #include "nimbus/spectral/cie.h"
 #include "nimbus/spectral/color.h"
 #include "nimbus/spectral/spectral_curve.h"
+#include "nimbus/spectral/spectral_param.h"
 #include "nimbus/spectral/wavelengths.h"
 #include "support/chandrasekhar.h"
 #include "support/scene_builders.h"
@@ -96,6 +97,33 @@ TEST_P(SpectralRender, WhiteFurnace) {
   EXPECT_GT(r.counters.scatter_events, 1000u);
 }
 
+// Kirchhoff in spectral mode: a chromatic medium that emits L_e = D65 (RGB 1) wherever it
+// absorbs, under an environment of the same spectrum, is in equilibrium at every wavelength.
+TEST_P(SpectralRender, EmissiveFurnaceIsInEquilibrium) {
+  const SpectralCase& c = GetParam();
+  Scene scene;
+  scene.settings = {12, 12, 64, 6, 100000, tracking_of(c), {}};
+  scene.settings.spectral = spectral(c.wavelengths);
+  scene.camera = perspective_camera({0, 0.3, 3.5}, {0, 0, 0}, {0, 1, 0}, 40, 12, 12);
+  Medium m;
+  m.sigma_s = Rgb({4.0, 1.0, 6.0});
+  m.sigma_a = Rgb({2.0, 4.0, 0.5});
+  m.emission = Rgb(1.0);
+  m.density = Medium::Density::Cloud;
+  m.cloud = make_cloud_density(CloudParams{});
+  scene.media.push_back(m);
+  scene.objects.push_back(
+      test::object_of(make_shape(QuadricNode{sphere({0, 0, 0}, 1)}), Surface::Type::None, 0));
+  scene.lights.push_back(test::environment(1.0));
+  test::finish_media(scene);
+  const Rgb ref = film_value([&](double l) { return d65_illuminant(l); });
+  const RenderResult r = render(scene);
+  const MeanEstimate est = image_mean(r.film);
+  for (int ch = 0; ch < 3; ++ch)
+    EXPECT_NEAR(est.mean[ch], ref[ch], 4 * est.standard_error[ch]) << "channel " << ch;
+  EXPECT_GT(r.counters.real_collisions, 1000u);
+}
+
 // Chandrasekhar's half-space (as in media_render_test.cpp) with a sampled albedo ω(λ):
 // sigma_s = ω, sigma_a = 1 − ω (both piecewise linear on the same knots, so mu_t = 1), lit by a
 // sun of constant irradiance 2. The reference integrates the exact reflection per wavelength.
@@ -119,8 +147,8 @@ TEST_P(SpectralRender, ChandrasekharHalfSpace) {
   std::vector<std::pair<double, double>> absorption;
   for (const auto& [nm, w] : albedo) absorption.emplace_back(nm, 1 - w);
   Medium m;
-  m.sigma_s.curve = piecewise_linear_spectrum(albedo);
-  m.sigma_a.curve = piecewise_linear_spectrum(absorption);
+  m.sigma_s.curve.emplace(piecewise_linear_spectrum(albedo));
+  m.sigma_a.curve.emplace(piecewise_linear_spectrum(absorption));
   scene.media.push_back(m);
   scene.objects.push_back(
       test::object_of(make_shape(QuadricNode{sphere({0, -R, 0}, R)}), Surface::Type::None, 0));
@@ -150,6 +178,41 @@ std::vector<SpectralCase> spectral_cases() {
 }
 
 INSTANTIATE_TEST_SUITE_P(Modes, SpectralRender, testing::ValuesIn(spectral_cases()), case_name);
+
+// A convex diffuse object under a uniform environment reflects albedo × environment at every
+// wavelength: a sampled albedo under a 4000 K blackbody sky, seen only where the sphere is.
+TEST(SpectralRenderSurfaces, SampledAlbedoUnderABlackbodySky) {
+  Scene scene;
+  scene.settings = {
+      8,          8,    256,
+      13,         1000, test::tracking_settings(Mode::SpectralMis, Absorption::Collide, false, 0),
+      spectral(8)};
+  scene.camera = orthographic_camera({0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.6, 8, 8);
+  SceneObject ball =
+      test::object_of(make_shape(QuadricNode{sphere({0, 0, 0}, 1)}), Surface::Type::Diffuse, -1);
+  ball.surface.albedo = from_curve(
+      piecewise_linear_spectrum({{400, 0.2}, {480, 0.9}, {560, 0.3}, {640, 0.7}, {700, 0.1}}),
+      SpectralRole::Albedo);
+  scene.objects.push_back(std::move(ball));
+  Light sky;
+  sky.type = Light::Type::Environment;
+  sky.emission = from_curve(blackbody_spectrum(4000, 1.5), SpectralRole::Illuminant);
+  scene.lights.push_back(sky);
+  test::finish_media(scene);
+  const SpectralCurve albedo = *scene.objects[0].surface.albedo.curve;
+  const SpectralCurve sky_curve = *scene.lights[0].emission.curve;
+  const Rgb ref = film_value([&](double l) { return albedo(l) * sky_curve(l); });
+  const RenderResult r = render(scene);
+  const MeanEstimate est = image_mean(r.film);
+  for (int ch = 0; ch < 3; ++ch) {
+    EXPECT_GT(est.standard_error[ch], 0);
+    EXPECT_NEAR(est.mean[ch], ref[ch], 4 * est.standard_error[ch]) << "channel " << ch;
+  }
+  // Its rgb-mode projection is a different, cruder answer: the product of the projections.
+  EXPECT_GT(
+      std::abs(ref[1] - scene.objects[0].surface.albedo.rgb[1] * scene.lights[0].emission.rgb[1]),
+      1e-3);
+}
 
 // A grey scene (grey cloud, grey diffuse floor, white sun and sky) has the same expected image
 // in rgb and spectral modes: every spectrum in it is a constant or D65 times one.
