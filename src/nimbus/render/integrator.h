@@ -56,15 +56,16 @@ struct LightCandidate {
 
 template <int N, class F>
 std::optional<LightCandidate<N>> light_candidate(const Scene& scene, const PathSpectra<N>& ps,
-                                                 const Light& light, const Vec3& p, const Vec3& n,
+                                                 int light_index, const Vec3& p, const Vec3& n,
                                                  bool on_surface, F&& f, Rng& rng) {
+  const Light& light = scene.lights[light_index];
   const double u1 = rng.uniform(), u2 = rng.uniform();
   const auto ls = sample_light(light, p, u1, u2);
   if (!ls) return std::nullopt;
   if (on_surface && dot(ls->wi, n) <= 0) return std::nullopt;
   const Spectrum<N> fv = f(ls->wi);
   if (fv.is_black()) return std::nullopt;
-  return LightCandidate<N>{*ls, fv, evaluate(light.emission, ps.ch) * ls->falloff,
+  return LightCandidate<N>{*ls, fv, ps.lights[light_index] * ls->falloff,
                            on_surface ? offset_origin(scene, p, n, ls->wi) : p};
 }
 
@@ -77,7 +78,7 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Vec
                          Counters& counters) {
   Spectrum<N> L(0.0);
   for (int i = 0; i < static_cast<int>(scene.lights.size()); ++i) {
-    const auto cand = light_candidate(scene, ps, scene.lights[i], p, n, on_surface, f, rng);
+    const auto cand = light_candidate(scene, ps, i, p, n, on_surface, f, rng);
     if (!cand) continue;
     const LightSample* ls = &cand->ls;
     const Spectrum<N>& fv = cand->f;
@@ -140,7 +141,7 @@ Spectrum<N> direct_light_mis(const Scene& scene, const PathSpectra<N>& ps, const
                              Counters& counters) {
   Spectrum<N> L(0.0);
   for (int i = 0; i < static_cast<int>(scene.lights.size()); ++i) {
-    const auto cand = light_candidate(scene, ps, scene.lights[i], p, n, on_surface, f, rng);
+    const auto cand = light_candidate(scene, ps, i, p, n, on_surface, f, rng);
     if (!cand) continue;
     const LightSample* ls = &cand->ls;
     const Spectrum<N>& fv = cand->f;
@@ -172,8 +173,9 @@ Spectrum<N> radiance_spectral_mis(const Scene& scene, const PathSpectra<N>& ps, 
   bool specular = true;
   Vec3 prev_p = ray.o;
   // Radiance Le arriving along the ray from `light`, which next-event estimation also samples.
-  auto from_light = [&](const Light& light) {
-    const Spectrum<N> Le = evaluate(light.emission, ps.ch);
+  auto from_light = [&](int light_index) {
+    const Light& light = scene.lights[light_index];
+    const Spectrum<N>& Le = ps.lights[light_index];
     if (specular) return path.beta * Le / path.r_u.average();
     const Spectrum<N> r_l = path.r_l * light_pdf(light, prev_p, ray.d);
     return path.beta * Le / (path.r_u + r_l).average();
@@ -208,12 +210,12 @@ Spectrum<N> radiance_spectral_mis(const Scene& scene, const PathSpectra<N>& ps, 
     }
 
     if (!hit) {
-      for (const Light& light : scene.lights)
-        if (light.type == Light::Type::Environment) L += from_light(light);
+      for (size_t i = 0; i < scene.lights.size(); ++i)
+        if (scene.lights[i].type == Light::Type::Environment) L += from_light(int(i));
       break;
     }
     if (hit->light >= 0) {
-      L += from_light(scene.lights[hit->light]);
+      L += from_light(hit->light);
       break;
     }
     const SceneObject& obj = scene.objects[hit->object];
@@ -304,14 +306,13 @@ Spectrum<N> radiance(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Rng&
     }
 
     if (!hit) {
-      for (const Light& light : scene.lights)
-        if (light.type == Light::Type::Environment)
-          L += s.beta * evaluate(light.emission, ps.ch) * mis_weight(light);
+      for (size_t i = 0; i < scene.lights.size(); ++i)
+        if (scene.lights[i].type == Light::Type::Environment)
+          L += s.beta * ps.lights[i] * mis_weight(scene.lights[i]);
       break;
     }
     if (hit->light >= 0) {
-      const Light& light = scene.lights[hit->light];
-      L += s.beta * evaluate(light.emission, ps.ch) * mis_weight(light);
+      L += s.beta * ps.lights[hit->light] * mis_weight(scene.lights[hit->light]);
       break;
     }
     const SceneObject& obj = scene.objects[hit->object];

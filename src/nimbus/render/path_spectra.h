@@ -1,8 +1,8 @@
 #pragma once
 // What a path's N channels are (docs/spectra.md): in rgb mode the three RGB channels; in spectral
-// mode N wavelengths drawn for the path. Each path evaluates the media's coefficients at its
-// channels once, so the tracking estimators see plain Spectrum<N> values either way and run
-// unchanged; the film turns a path's channels into linear sRGB.
+// mode N wavelengths drawn for the path. Each path evaluates the media's coefficients and the
+// lights' emission at its channels once, so the tracking estimators see plain Spectrum<N> values
+// either way and run unchanged; the film turns a path's channels into linear sRGB.
 
 #include <algorithm>
 #include <array>
@@ -44,6 +44,7 @@ template <int N>
 struct PathSpectra {
   Channels<N> ch;
   std::vector<MediumCoefficients<N>> media;  // indexed as scene.media
+  std::vector<Spectrum<N>> lights;           // each light's emission, indexed as scene.lights
 };
 
 // The octree's bins in spectral mode: kSpectralBins intervals of equal probability under the
@@ -68,6 +69,9 @@ void prepare_path_spectra(PathSpectra<N>& ps, const Scene& scene, double u) {
     ps.media[m] = {evaluate(med.sigma_a, ps.ch), evaluate(med.sigma_s, ps.ch),
                    evaluate(med.emission, ps.ch)};
   }
+  ps.lights.resize(scene.lights.size());
+  for (size_t l = 0; l < scene.lights.size(); ++l)
+    ps.lights[l] = evaluate(scene.lights[l].emission, ps.ch);
 }
 
 // A path's radiance at its channels as linear sRGB: itself in rgb mode; in spectral mode the
