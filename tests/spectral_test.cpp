@@ -207,33 +207,42 @@ TEST(SpectralColor, XyzAndSrgbAreInverses) {
 // ---------------------------------------------------------------------------------------------
 // RGB upsampling
 
+// Grey inputs become constant spectra exactly, whose projection is D65's white in sRGB: off
+// (1, 1, 1) by up to 4.02e-4 (SpectralCie.D65IsTheSrgbWhite). Every other colour is polished by
+// Gauss–Newton after the table lookup; measured: largest error 1.0e-13 over 4·10⁵ uniform
+// colours (2.2e-13 relative to max(rgb) for dark ones), against 2.0e-3 from the table alone.
+constexpr double kPolished = 1e-12;
+constexpr double kGreyWhite = 4.1e-4;
+
+bool is_grey(const Rgb& c) {
+  return c[0] == c[1] && c[1] == c[2];
+}
+
 TEST(SpectralUpsampling, AlbedoRoundTrip) {
-  // Measured maxima: 7.2e-4 on this 11³ grid, 2.0e-3 over 4·10⁵ uniform random colours.
-  double worst = 0;
   for (const Rgb& rgb : grid_colours(11, 1)) {
-    const SpectralCurve s = rgb_albedo_spectrum(rgb);
-    const double error = max_abs_diff(reflectance_to_rgb(s), rgb);
-    worst = std::max(worst, error);
-    EXPECT_LT(error, 1e-3) << rgb[0] << " " << rgb[1] << " " << rgb[2];
+    const double error = max_abs_diff(reflectance_to_rgb(rgb_albedo_spectrum(rgb)), rgb);
+    EXPECT_LT(error, is_grey(rgb) ? kGreyWhite * rgb.max() + 1e-15 : kPolished)
+        << rgb[0] << " " << rgb[1] << " " << rgb[2];
   }
   Rng rng(8, 4);
   for (int n = 0; n < 20000; ++n) {
     const Rgb rgb({rng.uniform(), rng.uniform(), rng.uniform()});
     const double error = max_abs_diff(reflectance_to_rgb(rgb_albedo_spectrum(rgb)), rgb);
-    EXPECT_LT(error, 2.5e-3) << rgb[0] << " " << rgb[1] << " " << rgb[2];
+    EXPECT_LT(error, kPolished) << rgb[0] << " " << rgb[1] << " " << rgb[2];
   }
-  EXPECT_GT(worst, 1e-5);  // the grid does exercise the table (not only the grey axis)
+  // Bright colours next to grey, the table's worst case (1.3e-3 before polishing).
+  for (const Rgb& rgb : {Rgb({0.9995, 0.999, 0.99}), Rgb({0.999, 0.998, 0.997})})
+    EXPECT_LT(max_abs_diff(reflectance_to_rgb(rgb_albedo_spectrum(rgb)), rgb), kPolished);
 }
 
 TEST(SpectralUpsampling, DarkColoursKeepTheirRelativeAccuracy) {
-  // Below the table's z range the curve is scaled, so the error relative to max(rgb) stays that
-  // of the table: measured 1.09e-3 over 4·10⁵ colours with max(rgb) log-uniform in [1e-6, 1].
+  // Below the table's z range the curve is scaled, so the error stays relative to max(rgb).
   Rng rng(8, 5);
   for (int n = 0; n < 20000; ++n) {
     Rgb rgb({rng.uniform(), rng.uniform(), rng.uniform()});
     rgb = rgb * (std::pow(10.0, -6 * rng.uniform()) / rgb.max());
     const double error = max_abs_diff(reflectance_to_rgb(rgb_albedo_spectrum(rgb)), rgb);
-    EXPECT_LT(error / rgb.max(), 1.25e-3) << rgb[0] << " " << rgb[1] << " " << rgb[2];
+    EXPECT_LT(error / rgb.max(), kPolished) << rgb[0] << " " << rgb[1] << " " << rgb[2];
   }
 }
 
@@ -254,11 +263,12 @@ TEST(SpectralUpsampling, GreyIsConstant) {
 
 TEST(SpectralUpsampling, UnboundedAndIlluminantRoundTrips) {
   // The curve is 2·max(rgb) times an albedo curve with largest component 1/2, so its error scales
-  // with max(rgb). Measured on this grid: 1.03e-3 · max(rgb) for both.
+  // with max(rgb).
   for (const Rgb& rgb : grid_colours(11, 10)) {
-    const double tolerance = 1.25e-3 * std::max(rgb.max(), 1e-300);
+    const double tolerance = (is_grey(rgb) ? kGreyWhite : kPolished) * rgb.max() + 1e-300;
     const Rgb unbounded = reflectance_to_rgb(rgb_unbounded_spectrum(rgb));
     EXPECT_LE(max_abs_diff(unbounded, rgb), tolerance) << rgb[0] << " " << rgb[1] << " " << rgb[2];
+    // Emission of grey times D65 is exactly the sRGB white of the data.
     const Rgb emitted = emission_to_rgb(rgb_illuminant_spectrum(rgb));
     EXPECT_LE(max_abs_diff(emitted, rgb), tolerance) << rgb[0] << " " << rgb[1] << " " << rgb[2];
   }

@@ -147,6 +147,73 @@ const Grid& grid() {
   return g;
 }
 
+// The sigmoid curve with coefficients c in the table's variable t.
+SpectralCurve sigmoid_curve(const std::array<double, 3>& c) {
+  const auto nm = to_nm(c[0], c[1], c[2]);
+  SpectralCurve s;
+  s.type = SpectralCurve::Type::Sigmoid;
+  s.c0 = nm[0];
+  s.c1 = nm[1];
+  s.c2 = nm[2];
+  return s;
+}
+
+double max_abs(const Rgb& r) {
+  return std::max({std::abs(r[0]), std::abs(r[1]), std::abs(r[2])});
+}
+
+// Gauss–Newton steps on interpolated coefficients: trilinear interpolation of the table misses
+// the target by up to ~1e-3, and a few steps bring reflectance_to_rgb to it at round-off wherever
+// a sigmoid reaches it. A step that does not reduce the residual is halved, and the polish stops
+// when none does, so it never does worse than the table.
+std::array<double, 3> polish(std::array<double, 3> c, const Rgb& target) {
+  constexpr int kSteps = 6;
+  constexpr double kDone = 1e-13;
+  auto residual = [&](const std::array<double, 3>& k) {
+    return reflectance_to_rgb(sigmoid_curve(k)) - target;
+  };
+  Rgb r = residual(c);
+  double error = max_abs(r);
+  for (int step = 0; step < kSteps && error > kDone; ++step) {
+    double J[3][3];  // J[i][j] = ∂ r_i / ∂ c_j, by forward differences
+    for (int j = 0; j < 3; ++j) {
+      std::array<double, 3> k = c;
+      const double h = 1e-7 * (1 + std::abs(c[j]));
+      k[j] += h;
+      const Rgb rj = residual(k);
+      for (int i = 0; i < 3; ++i) J[i][j] = (rj[i] - r[i]) / h;
+    }
+    // Solve J d = −r by Cramer's rule.
+    auto det3 = [](const double m[3][3]) {
+      return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+             m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+             m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    };
+    const double det = det3(J);
+    if (!(std::abs(det) > 0) || !std::isfinite(det)) break;
+    std::array<double, 3> d;
+    for (int j = 0; j < 3; ++j) {
+      double m[3][3];
+      for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 3; ++k) m[i][k] = k == j ? -r[i] : J[i][k];
+      d[j] = det3(m) / det;
+    }
+    bool improved = false;
+    for (double t = 1; t > 1.0 / 64 && !improved; t *= 0.5) {
+      const std::array<double, 3> k = {c[0] + t * d[0], c[1] + t * d[1], c[2] + t * d[2]};
+      const Rgb rk = residual(k);
+      if (max_abs(rk) < error) {
+        c = k;
+        r = rk;
+        error = max_abs(rk);
+        improved = true;
+      }
+    }
+    if (!improved) break;
+  }
+  return c;
+}
+
 }  // namespace
 
 double SpectralCurve::operator()(double lambda) const {
@@ -197,7 +264,7 @@ SpectralCurve rgb_albedo_spectrum(const Rgb& rgb_in) {
         std::clamp(static_cast<int>(std::upper_bound(n, n + size, coords[d]) - n) - 1, 0, size - 2);
     frac[d] = (coords[d] - n[cell[d]]) / (n[cell[d] + 1] - n[cell[d]]);
   }
-  double c[3] = {0, 0, 0};
+  std::array<double, 3> c = {0, 0, 0};
   for (int corner = 0; corner < 8; ++corner) {
     double w = 1;
     int i[3];
@@ -209,15 +276,11 @@ SpectralCurve rgb_albedo_spectrum(const Rgb& rgb_in) {
     const int index = table_index(l, i[0], i[1], i[2]);
     for (int j = 0; j < 3; ++j) c[j] += w * table_entry(index + j);
   }
-  const auto nm = to_nm(c[0], c[1], c[2]);
-  SpectralCurve s;
-  s.type = SpectralCurve::Type::Sigmoid;
   // Below kZMin, the curve at kZMin scaled down: reflectance_to_rgb is linear, so the scaled
   // curve keeps its chromaticity and reaches z.
-  s.scale = std::min(1.0, z / kZMin);
-  s.c0 = nm[0];
-  s.c1 = nm[1];
-  s.c2 = nm[2];
+  const double scale = std::min(1.0, z / kZMin);
+  SpectralCurve s = sigmoid_curve(polish(c, rgb / scale));
+  s.scale = scale;
   return s;
 }
 

@@ -2,7 +2,8 @@
 // A spectral distribution that a scene defines: a value per wavelength (nm). RGB inputs become
 // smooth curves here (docs/spectra.md): a reflectance-like RGB in [0, 1] becomes a sigmoid of a
 // quadratic, s(λ) = S(c0 λ² + c1 λ + c2) with S(x) = 1/2 + x / (2 √(1 + x²)), bounded in [0, 1]
-// (Jakob and Hanika 2019), its coefficients interpolated from a table generated at build time;
+// (Jakob and Hanika 2019), its coefficients interpolated from a table generated at build time
+// and polished by Gauss–Newton;
 // unbounded RGB (coefficients, radiance) is a scale times such a curve; illuminants are further
 // multiplied by D65 so that an RGB white light renders white.
 
@@ -32,9 +33,10 @@ struct SpectralCurve {
 };
 
 SpectralCurve constant_spectrum(double value);
-// rgb in [0, 1]³: a curve in [0, 1] whose reflectance_to_rgb is rgb (within the table's error).
-// Grey (r = g = b) gives the constant exactly. Components are clamped into [0, 1]; a largest
-// component below 1/2 gives the curve at 1/2 scaled down (docs/spectra.md).
+// rgb in [0, 1]³: a curve in [0, 1] whose reflectance_to_rgb is rgb to ~1e-13, except grey
+// (r = g = b), which gives the constant exactly (projecting to D65's white, off by 4e-4).
+// Components are clamped into [0, 1]; a largest component below 1/2 gives the curve at 1/2 scaled
+// down (docs/spectra.md).
 SpectralCurve rgb_albedo_spectrum(const Rgb& rgb);
 // rgb >= 0: scale 2·max(rgb) times the albedo curve of rgb / scale. Grey gives the constant.
 SpectralCurve rgb_unbounded_spectrum(const Rgb& rgb);
