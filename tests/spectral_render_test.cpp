@@ -69,58 +69,55 @@ Rgb film_value(L&& radiance) {
 
 class SpectralRender : public testing::TestWithParam<SpectralCase> {};
 
-// An albedo-1 medium with chromatic sigma_s (upsampled from RGB (1, 3, 6)) under a white
-// environment: every wavelength sees L = D65, so the image is the sRGB of D65, white.
-TEST_P(SpectralRender, WhiteFurnace) {
-  const SpectralCase& c = GetParam();
-  if (c.mode == Mode::SpectralMax) GTEST_SKIP() << "the max rule has infinite variance here";
+// A unit sphere holding `medium` (index-matched) under a white environment (D65 in spectral
+// mode), rendered with the case's tracking and wavelength count.
+RenderResult render_furnace(const SpectralCase& c, const Medium& medium, uint64_t seed) {
   Scene scene;
-  scene.settings = {12, 12, 64, 5, 100000, tracking_of(c), {}};
-  scene.settings.spectral = spectral(c.wavelengths);
+  scene.settings = {12, 12, 64, seed, 100000, tracking_of(c), spectral(c.wavelengths)};
   scene.camera = perspective_camera({0, 0.3, 3.5}, {0, 0, 0}, {0, 1, 0}, 40, 12, 12);
-  Medium m;
-  m.sigma_s = Rgb({1.0, 3.0, 6.0});
-  m.g = 0.4;
-  scene.media.push_back(m);
+  scene.media.push_back(medium);
   scene.objects.push_back(
       test::object_of(make_shape(QuadricNode{sphere({0, 0, 0}, 1)}), Surface::Type::None, 0));
   scene.lights.push_back(test::environment(1.0));
   test::finish_media(scene);
+  return render(scene);
+}
+
+// The image of a furnace in equilibrium: the sRGB of D65 (white) everywhere.
+void expect_d65_white(const RenderResult& r) {
   const Rgb ref = film_value([&](double l) { return d65_illuminant(l); });
-  const RenderResult r = render(scene);
   const MeanEstimate est = image_mean(r.film);
   for (int ch = 0; ch < 3; ++ch) {
     EXPECT_NEAR(ref[ch], 1.0, 2e-3) << "D65 is sRGB's white";
     EXPECT_GT(est.standard_error[ch], 0);
     EXPECT_NEAR(est.mean[ch], ref[ch], 4 * est.standard_error[ch]) << "channel " << ch;
   }
+}
+
+// An albedo-1 medium with chromatic sigma_s (upsampled from RGB (1, 3, 6)) under a white
+// environment: every wavelength sees L = D65, so the image is the sRGB of D65, white.
+TEST_P(SpectralRender, WhiteFurnace) {
+  const SpectralCase& c = GetParam();
+  if (c.mode == Mode::SpectralMax) GTEST_SKIP() << "the max rule has infinite variance here";
+  Medium m;
+  m.sigma_s = Rgb({1.0, 3.0, 6.0});
+  m.g = 0.4;
+  const RenderResult r = render_furnace(c, m, 5);
+  expect_d65_white(r);
   EXPECT_GT(r.counters.scatter_events, 1000u);
 }
 
 // Kirchhoff in spectral mode: a chromatic medium that emits L_e = D65 (RGB 1) wherever it
 // absorbs, under an environment of the same spectrum, is in equilibrium at every wavelength.
 TEST_P(SpectralRender, EmissiveFurnaceIsInEquilibrium) {
-  const SpectralCase& c = GetParam();
-  Scene scene;
-  scene.settings = {12, 12, 64, 6, 100000, tracking_of(c), {}};
-  scene.settings.spectral = spectral(c.wavelengths);
-  scene.camera = perspective_camera({0, 0.3, 3.5}, {0, 0, 0}, {0, 1, 0}, 40, 12, 12);
   Medium m;
   m.sigma_s = Rgb({4.0, 1.0, 6.0});
   m.sigma_a = Rgb({2.0, 4.0, 0.5});
   m.emission = Rgb(1.0);
   m.density = Medium::Density::Cloud;
   m.cloud = make_cloud_density(CloudParams{});
-  scene.media.push_back(m);
-  scene.objects.push_back(
-      test::object_of(make_shape(QuadricNode{sphere({0, 0, 0}, 1)}), Surface::Type::None, 0));
-  scene.lights.push_back(test::environment(1.0));
-  test::finish_media(scene);
-  const Rgb ref = film_value([&](double l) { return d65_illuminant(l); });
-  const RenderResult r = render(scene);
-  const MeanEstimate est = image_mean(r.film);
-  for (int ch = 0; ch < 3; ++ch)
-    EXPECT_NEAR(est.mean[ch], ref[ch], 4 * est.standard_error[ch]) << "channel " << ch;
+  const RenderResult r = render_furnace(GetParam(), m, 6);
+  expect_d65_white(r);
   EXPECT_GT(r.counters.real_collisions, 1000u);
 }
 
