@@ -254,25 +254,12 @@ TEST_P(MediaRender, WhiteFurnaceBehindLosslessDielectric) {
 // directional light and seen from above: Chandrasekhar's exact diffuse reflection.
 void expect_chandrasekhar(double theta0_deg, double theta_deg, const Rgb& albedo,
                           const TrackingSettings& tracking) {
-  const double R = 1000;
   const double mu0 = std::cos(theta0_deg * kPi / 180), mu = std::cos(theta_deg * kPi / 180);
-  Scene scene;
-  scene.settings = {6, 6, 2048, 3, 100000, tracking, {}};
-  const Vec3 view_dir{std::sin(theta_deg * kPi / 180), -mu, 0};
-  scene.camera =
-      orthographic_camera(Vec3{0, 0, 0} - view_dir * 5.0, {0, 0, 0}, {0, 0, 1}, 0.5, 6, 6);
-  Light sun;
-  sun.type = Light::Type::Directional;
-  sun.direction = normalize(Vec3{0, -mu0, -std::sqrt(1 - mu0 * mu0)});
-  sun.emission = Rgb(2.0);
-  scene.lights.push_back(sun);
   Medium m;
   m.sigma_s = albedo;
   m.sigma_a = Rgb(1.0) - albedo;  // mu_t = 1
-  scene.media.push_back(m);
-  scene.objects.push_back(
-      test::object_of(make_shape(QuadricNode{sphere({0, -R, 0}, R)}), Surface::Type::None, 0));
-  test::finish_media(scene);
+  const Scene scene = test::half_space_scene(theta0_deg, theta_deg, m, Rgb(2.0),
+                                             {6, 6, 2048, 3, 100000, tracking, {}});
   const RenderResult r = render(scene);
   const MeanEstimate est = image_mean(r.film);
   for (int c = 0; c < 3; ++c) {

@@ -126,19 +126,7 @@ TEST_P(SpectralRender, EmissiveFurnaceIsInEquilibrium) {
 // sun of constant irradiance 2. The reference integrates the exact reflection per wavelength.
 TEST_P(SpectralRender, ChandrasekharHalfSpace) {
   const SpectralCase& c = GetParam();
-  const double R = 1000, mu0 = 1.0, mu = std::cos(30 * kPi / 180);
-  Scene scene;
-  scene.settings = {6, 6, 2048, 3, 100000, tracking_of(c), {}};
-  scene.settings.spectral = spectral(c.wavelengths);
-  const Vec3 view_dir{std::sin(30 * kPi / 180), -mu, 0};
-  scene.camera =
-      orthographic_camera(Vec3{0, 0, 0} - view_dir * 5.0, {0, 0, 0}, {0, 0, 1}, 0.5, 6, 6);
-  Light sun;
-  sun.type = Light::Type::Directional;
-  sun.direction = {0, -1, 0};
-  sun.emission.rgb = Rgb(2.0);
-  sun.emission.curve = constant_spectrum(2.0);
-  scene.lights.push_back(sun);
+  const double mu0 = 1.0, mu = std::cos(30 * kPi / 180);
   const std::vector<std::pair<double, double>> albedo = {
       {360, 0.3}, {450, 0.95}, {520, 0.6}, {600, 0.85}, {830, 0.4}};
   std::vector<std::pair<double, double>> absorption;
@@ -146,10 +134,10 @@ TEST_P(SpectralRender, ChandrasekharHalfSpace) {
   Medium m;
   m.sigma_s.curve.emplace(piecewise_linear_spectrum(albedo));
   m.sigma_a.curve.emplace(piecewise_linear_spectrum(absorption));
-  scene.media.push_back(m);
-  scene.objects.push_back(
-      test::object_of(make_shape(QuadricNode{sphere({0, -R, 0}, R)}), Surface::Type::None, 0));
-  test::finish_media(scene);
+  SpectralParam sun(Rgb(2.0));
+  sun.curve = constant_spectrum(2.0);
+  const Scene scene = test::half_space_scene(
+      0, 30, m, sun, {6, 6, 2048, 3, 100000, tracking_of(c), spectral(c.wavelengths)});
   const SpectralCurve omega = *scene.media[0].sigma_s.curve;
   const Rgb ref = film_value(
       [&](double l) { return test::half_space_reflected_radiance(2.0, omega(l), mu0, mu); });

@@ -1,8 +1,12 @@
 #pragma once
 // Building small scenes in code for renderer tests, as compile_scene would from a file.
 
+#include <cmath>
+
 #include "nimbus/frep/bounds.h"
+#include "nimbus/frep/primitives.h"
 #include "nimbus/frep/tape.h"
+#include "nimbus/math/constants.h"
 #include "nimbus/media/octree.h"
 #include "nimbus/render/scene.h"
 
@@ -48,6 +52,30 @@ inline void finish_media(Scene& scene) {
       scene.field_objects.push_back(static_cast<int>(i));
   complete_spectra(scene);
   build_majorant_octrees(scene);
+}
+
+// Chandrasekhar's half-space: `medium` filling a sphere of radius 1000 seen near its top by a
+// 6×6 orthographic camera at zenith angle theta, lit by a sun of `irradiance` at zenith angle
+// theta0 (chandrasekhar.h gives the reflected radiance).
+inline Scene half_space_scene(double theta0_deg, double theta_deg, const Medium& medium,
+                              const SpectralParam& irradiance, const RenderSettings& settings) {
+  const double R = 1000;
+  const double mu0 = std::cos(theta0_deg * kPi / 180), mu = std::cos(theta_deg * kPi / 180);
+  Scene scene;
+  scene.settings = settings;
+  const Vec3 view_dir{std::sin(theta_deg * kPi / 180), -mu, 0};
+  scene.camera = orthographic_camera(Vec3{0, 0, 0} - view_dir * 5.0, {0, 0, 0}, {0, 0, 1}, 0.5,
+                                     settings.width, settings.height);
+  Light sun;
+  sun.type = Light::Type::Directional;
+  sun.direction = normalize(Vec3{0, -mu0, -std::sqrt(1 - mu0 * mu0)});
+  sun.emission = irradiance;
+  scene.lights.push_back(sun);
+  scene.media.push_back(medium);
+  scene.objects.push_back(
+      object_of(make_shape(QuadricNode{sphere({0, -R, 0}, R)}), Surface::Type::None, 0));
+  finish_media(scene);
+  return scene;
 }
 
 }  // namespace nimbus::test
