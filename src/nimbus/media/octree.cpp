@@ -192,6 +192,23 @@ Grown prune(Grown g, const MajorantOctree& tree) {
   return out;
 }
 
+// Floors a bin's sampled majorant mu_bar and minorant mu_c by its interval bounds [lo, hi].
+// Samples that all miss the medium (a leaf the medium only touches) give mu_bar = 0, which every
+// tracker would take for vacuum: the samples then say nothing and the bounds are kept. Samples
+// that all see one value give mu_bar = mu_c, which decomposition and residual ratio tracking
+// would take for a homogeneous leaf and never look up: the residual rate mu_bar − mu_c is kept at
+// least kSampledResidualFloor of the interval's (hi − lo). Both stay within [lo, hi].
+void floor_sampled_bounds(double lo, double hi, double& mu_bar, double& mu_c) {
+  if (!(mu_bar > 0)) {
+    mu_bar = hi;
+    mu_c = lo;
+    return;
+  }
+  const double gap = kSampledResidualFloor * (hi - lo);
+  mu_bar = std::min(hi, std::max(mu_bar, mu_c + gap));
+  mu_c = std::max(lo, std::min(mu_c, mu_bar - gap));
+}
+
 // The paper's preliminary pass: min and max of mu_t at random points of each non-empty leaf,
 // per bin (in spectral mode from each medium's sigma_t bounds over the bin). Interior nodes then
 // hold the hull of their children.
@@ -206,6 +223,7 @@ void sample_bounds(const Scene& scene, int inside, const std::vector<std::vector
     const Box box = box_of(g.centers[i], tree.half[g.levels[i]]);
     Rng rng(seed, i);
     double* out = &g.bounds[2 * bins * i];
+    const std::vector<double> interval(out, out + 2 * bins);
     std::fill(out, out + bins, 0.0);
     std::fill(out + bins, out + 2 * bins, Box::kInf);
     std::vector<double> mu(2 * bins);
@@ -221,6 +239,8 @@ void sample_bounds(const Scene& scene, int inside, const std::vector<std::vector
         out[bins + b] = std::min(out[bins + b], mu[bins + b]);
       }
     }
+    for (int b = 0; b < bins; ++b)
+      floor_sampled_bounds(interval[bins + b], interval[b], out[b], out[bins + b]);
   });
   // Children come after their parent, so a backward sweep sees them first.
   for (size_t i = g.nodes.size(); i-- > 0;) {

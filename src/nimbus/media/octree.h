@@ -7,7 +7,8 @@
 // Bounds (source "bound") come from interval arithmetic: evaluate(tape, node box) for every
 // object that may hold medium in the node, mapped through its density model and summed. They
 // provably bound mu_t. Source "sample" replaces the leaves' values by the minimum and maximum of
-// mu_t at random points (the paper's preliminary pass): tighter, but they may not bound. Which
+// mu_t at random points (the paper's preliminary pass): tighter, but they may not bound; floored
+// by the intervals where the samples missed the medium or saw no variation. Which
 // nodes are empty and where the tree splits always come from the intervals, so a sampled tree
 // never skips a node that may hold medium.
 //
@@ -41,6 +42,9 @@ inline constexpr int kOctreeMaxDepth = 16;
 inline constexpr double kOctreeHomogeneous = 0.02;
 inline constexpr double kOctreeThinNull = 0.05;
 inline constexpr std::size_t kOctreeMaxNodes = std::size_t{1} << 18;
+// Sampled bounds (source "sample") keep a residual rate mu_bar − mu_c of at least this fraction
+// of the interval bounds' gap, so no heterogeneous leaf passes for homogeneous (octree.cpp).
+inline constexpr double kSampledResidualFloor = 0.05;
 // What a density lookup costs in steps of the walk, for deciding which splits pay off.
 inline constexpr double kOctreeLookupCost = 16;
 
