@@ -16,6 +16,7 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <string>
 
 #include "nimbus/math/rng.h"
@@ -216,6 +217,23 @@ TEST(WeightedCollision, HistoryRuleIgnoresDeadChannels) {
   }
 }
 
+// u·c rounds up to c when c is subnormal: the event drawn must still have a positive
+// probability, or the weight becomes mu_n · c/(mu_bar · 0) = 0 · ∞ (issue 17).
+TEST(WeightedCollision, NeverTakesAnEventOfProbabilityZero) {
+  const double tiny = std::numeric_limits<double>::denorm_min();
+  const double u = std::nextafter(1.0, 0.0);
+  ASSERT_EQ(u * tiny, tiny) << "the rounding this test is about";
+  for (EventRule rule : {EventRule::Channel, EventRule::Max, EventRule::History})
+    for (bool absorb : {true, false}) {
+      const MediumSample<3> m{Rgb(absorb ? tiny : 0.0), Rgb(absorb ? 0.0 : tiny), Rgb(0.0)};
+      Rgb w(1.0), e(0.0);
+      const TentativeEvent ev =
+          weighted_collision(m, Rgb(0.0), 1.0, EventPolicy{rule, 0, true}, w, e, u);
+      EXPECT_EQ(ev, absorb ? TentativeEvent::Absorb : TentativeEvent::Scatter);
+      for (int c = 0; c < 3; ++c) EXPECT_TRUE(std::isfinite(w[c]) && std::isfinite(e[c])) << c;
+    }
+}
+
 // Spectral MIS: escaping walks score beta / avg(r_u), the one-sample MIS over a uniform hero.
 TEST(HeroTracking, OneSampleMisIsUnbiased) {
   const Profile p;
@@ -257,6 +275,46 @@ TEST(HeroTracking, ShadowRayTransmittance) {
       EXPECT_LT(z, 4);
     else
       EXPECT_GT(z, 4);
+  }
+}
+
+// Issue 17: channel 1's majorant fails everywhere (half its bound), channels 0 and 2 bound.
+// Channel 1's technique cannot sample a null event, but the others' can, so the one-sample MIS
+// over the hero stays unbiased for every channel, in free flights and in shadow rays; clamping
+// channel 1's mu_n at 0 biased it.
+TEST(HeroTracking, UnbiasedWhereOneChannelsMajorantFails) {
+  for (double density : {1.0, 1.1}) {  // 1.1: the power to see a 10 % denser medium
+    Profile p;
+    p.density = density;
+    Rgb mu_maj = Profile{}.majorant() * 1.1;
+    mu_maj[1] = 0.5 * Profile{}.majorant()[1];
+    auto lookup = [&](double t) { return p.at(t); };
+    Rng rng(14);
+    TrackingCounters counters;
+    Moments mom;
+    std::array<test::MeanVar, 3> shadow;
+    for (int i = 0; i < kWalks; ++i) {
+      MisPath<3> path;
+      Rgb emitted(0.0);
+      const Collision c =
+          hero_tracking<3>(lookup, kT0, kT1, mu_maj, i % 3, path, emitted, rng, counters);
+      mom.add(c, path.beta / path.r_u.average(), emitted);
+      MisPath<3> ray;
+      const bool alive =
+          hero_ratio_tracking<3>(lookup, kT0, kT1, mu_maj, i % 3, ray, rng, counters);
+      const Rgb T = alive ? ray.beta / ray.r_l.average() : Rgb(0.0);
+      for (int ch = 0; ch < 3; ++ch) shadow[ch].add(T[ch]);
+    }
+    double z = mom.max_z(Profile{}.transmittance());
+    for (int ch = 0; ch < 3; ++ch)
+      z = std::max(
+          z, std::abs(shadow[ch].mean - Profile{}.transmittance()[ch]) / shadow[ch].std_error());
+    if (density == 1) {
+      EXPECT_LT(z, 4);
+      EXPECT_EQ(counters.clamped, 0u) << "one channel bounds everywhere";
+    } else {
+      EXPECT_GT(z, 4);
+    }
   }
 }
 

@@ -8,16 +8,22 @@
 //   f / avg_λ (p_u,λ + p_l,λ) = beta / avg(r_u + r_l) (with MIS against next-event estimation).
 // Along a majorant segment of per-channel rates mu_maj, with T_maj = exp(−mu_maj Δt) since the
 // last tentative collision (eq. numbers from Miller et al.):
-//   scatter  pdf = T_maj[h] mu_s[h]:  beta, r_u *= T_maj mu_s / pdf
-//   null     pdf = T_maj[h] mu_n[h]:  beta, r_u *= T_maj mu_n / pdf,  r_l *= T_maj mu_maj / pdf
+//   scatter  pdf = T_maj[h] mu_s[h] b[h]:  beta *= T_maj mu_s / pdf,  r_u *= T_maj mu_s b / pdf
+//   null     pdf = T_maj[h] mu_n[h]:  beta *= T_maj mu_n / pdf,  r_u *= T_maj max(0, mu_n) / pdf,
+//            r_l *= T_maj mu_maj / pdf
 //   escape   beta, r_u, r_l *= T_maj / T_maj[h]
 //   emission scored at every tentative collision: beta T_maj/pdf mu_a L_e / avg(r_u mu_maj
 //   T_maj/pdf)
 //            with pdf = T_maj[h] mu_maj[h]
-// The hero's events are drawn with P_a = mu_a[h]/mu_maj[h], P_s = mu_s[h]/mu_maj[h] and
-// P_n = max(0, 1 − P_a − P_s); mu_n = max(0, mu_maj − mu_t). Where mu_t[h] > mu_maj[h] the
-// probabilities are renormalised, the point is counted in `counters.clamped`, and the estimate is
-// biased: this estimator needs bounding majorants.
+// with b = mu_maj / max(mu_maj, mu_t). The hero's events are drawn with P_* = mu_*[h] b[h] /
+// mu_maj[h], P_n = 1 − P_a − P_s: where the
+// majorant bounds, P_a = mu_a/mu_maj, P_s = mu_s/mu_maj, P_n = mu_n/mu_maj; where it does not
+// (mu_n = mu_maj − mu_t < 0), P_n = 0 and absorption and scattering share 1. Each channel's r_u
+// uses that channel's own probabilities (its technique cannot sample a null event where its
+// majorant fails), while beta carries the signed mu_n. So the estimate stays unbiased as long as
+// one channel's majorant bounds mu_t at each tentative collision (that channel's technique then
+// covers the null events the others cannot sample); where none does, the collision is counted in
+// `counters.clamped`. Shadow rays are always unbiased: their light pdf r_l never vanishes.
 
 #include <algorithm>
 #include <cmath>
@@ -71,12 +77,14 @@ Collision hero_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>
           const Spectrum<N> r_e = path.r_u * mu_maj * T_maj / pdf;
           if (r_e.average() > 0) emitted += path.beta * T_maj / pdf * mu_a_Le / r_e.average();
         }
-        double P_a = m.mu_a[h] / mu_maj[h], P_s = m.mu_s[h] / mu_maj[h];
-        if (P_a + P_s > 1) {
-          ++counters.clamped;
-          P_a /= P_a + P_s;
-          P_s = 1 - P_a;
-        }
+        const Spectrum<N> mu_t = m.mu_t();
+        const Spectrum<N> mu_n = mu_maj - mu_t;
+        if (mu_n.max() < 0) ++counters.clamped;
+        // b: where a channel's majorant fails, its technique's P_a and P_s are scaled to sum to 1.
+        Spectrum<N> bounded;
+        for (int i = 0; i < N; ++i) bounded[i] = mu_n[i] < 0 ? mu_maj[i] / mu_t[i] : 1.0;
+        const double P_a = m.mu_a[h] / mu_maj[h] * bounded[h];
+        const double P_s = m.mu_s[h] / mu_maj[h] * bounded[h];
         const double u = rng.uniform();
         if (u < P_a) {
           path.beta = Spectrum<N>(0.0);
@@ -84,17 +92,16 @@ Collision hero_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>
           return false;
         }
         if (u < P_a + P_s) {
-          const double pdf = T_maj[h] * m.mu_s[h];
+          const double pdf = T_maj[h] * m.mu_s[h] * bounded[h];
           path.beta *= T_maj * m.mu_s / pdf;
-          path.r_u *= T_maj * m.mu_s / pdf;
+          path.r_u *= T_maj * m.mu_s * bounded / pdf;
           c = {CollisionEvent::Scatter, t};
           return false;
         }
-        const Spectrum<N> mu_n = clamp_zero(mu_maj - m.mu_t());
         const double pdf = T_maj[h] * mu_n[h];
         if (pdf > 0) {
           path.beta *= T_maj * mu_n / pdf;
-          path.r_u *= T_maj * mu_n / pdf;
+          path.r_u *= T_maj * clamp_zero(mu_n) / pdf;
           path.r_l *= T_maj * mu_maj / pdf;
         }
         if (!(pdf > 0) || path.beta.is_black() || path.r_u.is_black()) {
@@ -111,9 +118,9 @@ Collision hero_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>
 // Ratio tracking of a shadow segment for spectral MIS: T_ray (in `path.beta`) and the light and
 // unidirectional pdfs rescaled by the hero's light-path pdf (pdf = T_maj[h] mu_maj[h] per
 // tentative collision):  T_ray *= T_maj mu_n / pdf,  r_l *= T_maj mu_maj / pdf,
-// r_u *= T_maj mu_n / pdf, and at the end all three *= T_maj / T_maj[h]. The transmittance is
-// T_ray / avg(r_u + r_l) once multiplied by the vertex pdfs. Russian roulette (q = 3/4) where
-// that estimate falls below 0.05. Returns false once T_ray is 0.
+// r_u *= T_maj max(0, mu_n) / pdf, and at the end all three *= T_maj / T_maj[h]. The transmittance
+// is T_ray / avg(r_u + r_l) once multiplied by the vertex pdfs. Russian roulette (q = 3/4) where
+// |that estimate| falls below 0.05. Returns false once T_ray is 0.
 template <int N, class Lookup>
 bool hero_ratio_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>& mu_maj, int h,
                          MisPath<N>& path, Rng& rng, TrackingCounters& counters) {
@@ -123,14 +130,13 @@ bool hero_ratio_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N
         const double dt = t - t_prev;
         t_prev = t;
         const Spectrum<N> T_maj = exp(mu_maj * -dt);
-        const Spectrum<N> mu_n = clamp_zero(mu_maj - m.mu_t());
-        if (m.mu_t()[h] > mu_maj[h]) ++counters.clamped;
+        const Spectrum<N> mu_n = mu_maj - m.mu_t();
         const double pdf = T_maj[h] * mu_maj[h];
         path.beta *= T_maj * mu_n / pdf;
         path.r_l *= T_maj * mu_maj / pdf;
-        path.r_u *= T_maj * mu_n / pdf;
+        path.r_u *= T_maj * clamp_zero(mu_n) / pdf;
         const Spectrum<N> T = path.beta / (path.r_u + path.r_l).average();
-        if (T.max() < 0.05) {
+        if (std::max(T.max(), -T.min()) < 0.05) {  // |T|: a majorant that fails makes it signed
           if (rng.uniform() < 0.75)
             path.beta = Spectrum<N>(0.0);
           else

@@ -75,19 +75,20 @@ TentativeEvent weighted_collision(const MediumSample<N>& m, const Spectrum<N>& m
     w = Spectrum<N>(0.0);
     return TentativeEvent::Absorb;
   }
-  // P_* = x/c, so mu_*/(mu_bar P_*) = mu_* c / (mu_bar x).
+  // P_* = x/c, so mu_*/(mu_bar P_*) = mu_* c / (mu_bar x). An event of probability 0 is never
+  // taken: u·c rounds up to c when c is subnormal, which would pick a null event with n = 0.
   const double uc = u * c;
-  if (uc < a) {
+  if (uc >= a + s && n > 0) {
+    w *= mu_n * (c / (mu_bar * n));
+    return TentativeEvent::Null;
+  }
+  if (uc < a || !(s > 0)) {
     w *= m.mu_a * (c / (mu_bar * a));
     emitted += w * m.L_e;
     return TentativeEvent::Absorb;
   }
-  if (uc < a + s) {
-    w *= m.mu_s * (c / (mu_bar * s));
-    return TentativeEvent::Scatter;
-  }
-  w *= mu_n * (c / (mu_bar * n));
-  return TentativeEvent::Null;
+  w *= m.mu_s * (c / (mu_bar * s));
+  return TentativeEvent::Scatter;
 }
 
 }  // namespace nimbus
