@@ -27,10 +27,12 @@ inline constexpr double kShadowShrink = 1 - 1e-7;
 template <int N>
 struct PathState {
   Spectrum<N> beta{1.0};
-  int inside = -1;       // the solid (dielectric) object the path is in, or -1
-  bool specular = true;  // the last vertex was the camera or a specular surface
-  double prev_pdf = 0;   // solid-angle pdf with which the current direction was sampled
-  Vec3 prev_p;           // where it was sampled
+  int inside = -1;  // the solid (dielectric) object the path is in, or -1
+  // The last vertex sampled the lights (next-event estimation), so a light the path hits next
+  // is weighted by MIS; false at the camera, at specular surfaces and inside solids.
+  bool light_sampled = false;
+  double prev_pdf = 0;  // solid-angle pdf with which the current direction was sampled
+  Vec3 prev_p;          // where it was sampled
 };
 
 // The solid object containing p (the camera may sit inside one).
@@ -72,9 +74,10 @@ std::optional<LightCandidate<N>> light_candidate(const Scene& scene, const PathS
 // Light reaching p along one sample of every light (next-event estimation), times the
 // scattering function `f(wi)` (cosine included for surfaces) and the transmittance through media;
 // MIS with the sampling of f for lights that sampling can hit.
+// `channel`: as for transmittance (delta tracking's channel, or -1 for all).
 template <int N, class F, class Pdf>
 Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Vec3& p, const Vec3& n,
-                         bool on_surface, int inside, F&& f, Pdf&& f_pdf, Rng& rng,
+                         bool on_surface, int inside, int channel, F&& f, Pdf&& f_pdf, Rng& rng,
                          Counters& counters) {
   Spectrum<N> L(0.0);
   for (int i = 0; i < static_cast<int>(scene.lights.size()); ++i) {
@@ -84,7 +87,7 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Vec
     const Spectrum<N>& fv = cand->f;
     const Vec3& o = cand->origin;
     const Spectrum<N> T = transmittance(scene, ps, {o, ls->wi}, ls->distance * kShadowShrink, i,
-                                        inside, rng, counters);
+                                        inside, channel, rng, counters);
     if (T.is_black()) continue;
     if (ls->delta)
       L += fv * cand->Li * T;
@@ -170,13 +173,13 @@ Spectrum<N> radiance_spectral_mis(const Scene& scene, const PathSpectra<N>& ps, 
   MisPath<N> path;
   const int hero = std::min(N - 1, static_cast<int>(rng.uniform() * N));
   int inside = solid_containing(scene, ray.o);
-  bool specular = true;
+  bool light_sampled = false;  // as PathState::light_sampled
   Vec3 prev_p = ray.o;
   // Radiance Le arriving along the ray from `light`, which next-event estimation also samples.
   auto from_light = [&](int light_index) {
     const Light& light = scene.lights[light_index];
     const Spectrum<N>& Le = ps.lights[light_index];
-    if (specular) return path.beta * Le / path.r_u.average();
+    if (!light_sampled) return path.beta * Le / path.r_u.average();
     const Spectrum<N> r_l = path.r_l * light_pdf(light, prev_p, ray.d);
     return path.beta * Le / (path.r_u + r_l).average();
   };
@@ -203,7 +206,7 @@ Spectrum<N> radiance_spectral_mis(const Scene& scene, const PathSpectra<N>& ps, 
       path.beta *= phase.weight;
       path.r_l = path.r_u / phase.pdf;
       prev_p = p;
-      specular = false;
+      light_sampled = inside < 0;
       ray = {p, phase.wi};
       if (!russian_roulette(path.beta, path.r_u.average(), depth, rng)) break;
       continue;
@@ -241,12 +244,12 @@ Spectrum<N> radiance_spectral_mis(const Scene& scene, const PathSpectra<N>& ps, 
       path.beta *= albedo;
       path.r_l = path.r_u / (dot(wi, ns) * kInvPi);
       prev_p = p;
-      specular = false;
+      light_sampled = true;
       ray = {offset_origin(scene, p, ns, wi), wi};
     } else {
       const DielectricSample ds = sample_dielectric(-ray.d, n, obj.surface.ior, rng.uniform());
       if (!ds.reflected) inside = dot(ds.wi, n) < 0 ? hit->object : -1;
-      specular = true;
+      light_sampled = false;
       ray = {offset_origin(scene, p, n, ds.wi), ds.wi};
     }
     if (!russian_roulette(path.beta, path.r_u.average(), depth, rng)) break;
@@ -272,7 +275,7 @@ Spectrum<N> radiance(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Rng&
   int channel = -1;
 
   auto mis_weight = [&](const Light& light) {
-    return s.specular ? 1.0 : power_heuristic(s.prev_pdf, light_pdf(light, s.prev_p, ray.d));
+    return s.light_sampled ? power_heuristic(s.prev_pdf, light_pdf(light, s.prev_p, ray.d)) : 1.0;
   };
 
   for (int depth = 0;; ++depth) {
@@ -288,10 +291,11 @@ Spectrum<N> radiance(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Rng&
       if (depth >= scene.settings.max_depth) break;
       const Vec3 p = ray.at(ev.t);
       const MediumPoint<N>& m = ev.medium;
-      // A solid's boundary is specular: no shadow ray can leave it, so skip NEE inside one.
+      // A solid's boundary is specular: no shadow ray can leave it, so skip NEE inside one (a
+      // light inside it is then found by phase sampling alone, with weight 1).
       if (s.inside < 0)
         L += s.beta * direct_light(
-                          scene, ps, p, {}, false, s.inside,
+                          scene, ps, p, {}, false, s.inside, channel,
                           [&](const Vec3& wi) { return phase_value(m, dot(ray.d, wi)); },
                           [&](const Vec3& wi) { return phase_pdf(m, dot(ray.d, wi)); }, rng,
                           counters);
@@ -299,7 +303,7 @@ Spectrum<N> radiance(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Rng&
       s.beta *= phase.weight;
       s.prev_pdf = phase.pdf;
       s.prev_p = p;
-      s.specular = false;
+      s.light_sampled = s.inside < 0;
       ray = {p, phase.wi};
       if (!russian_roulette(s.beta, 1.0, depth, rng)) break;
       continue;
@@ -329,7 +333,7 @@ Spectrum<N> radiance(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Rng&
       const Spectrum<N> albedo = evaluate(obj.surface.albedo, ps.ch);
       const Spectrum<N> f = albedo * kInvPi;
       L += s.beta * direct_light(
-                        scene, ps, p, ns, true, s.inside,
+                        scene, ps, p, ns, true, s.inside, channel,
                         [&](const Vec3& wi) { return f * dot(wi, ns); },
                         [&](const Vec3& wi) { return dot(wi, ns) * kInvPi; }, rng, counters);
       const double u1 = rng.uniform(), u2 = rng.uniform();
@@ -337,12 +341,12 @@ Spectrum<N> radiance(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Rng&
       s.beta *= albedo;  // f cos / pdf = albedo
       s.prev_pdf = dot(wi, ns) * kInvPi;
       s.prev_p = p;
-      s.specular = false;
+      s.light_sampled = true;
       ray = {offset_origin(scene, p, ns, wi), wi};
     } else {
       const DielectricSample ds = sample_dielectric(-ray.d, n, obj.surface.ior, rng.uniform());
       if (!ds.reflected) s.inside = dot(ds.wi, n) < 0 ? hit->object : -1;
-      s.specular = true;
+      s.light_sampled = false;
       ray = {offset_origin(scene, p, n, ds.wi), ds.wi};
     }
     if (!russian_roulette(s.beta, 1.0, depth, rng)) break;

@@ -146,10 +146,14 @@ MediumEvent<N> sample_collision_mis(const Scene& scene, const PathSpectra<N>& ps
 
 // Transmittance over (0, t_max) by ratio or residual ratio tracking (settings.transmittance),
 // and 0 if a surface blocks the way. `light` is the light the shadow ray aims at (it does not
-// block), or -1.
+// block), or -1. `channel` >= 0 (delta tracking once it has chosen its channel): the path's
+// throughput is in that channel alone, so only it is tracked, at its own majorant, with
+// roulette on its own estimate; the other channels come back 0. -1: every channel, at the
+// largest majorant.
 template <int N>
 Spectrum<N> transmittance(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray,
-                          double t_max, int light, int inside, Rng& rng, Counters& counters) {
+                          double t_max, int light, int inside, int channel, Rng& rng,
+                          Counters& counters) {
   ++counters.shadow_rays;
   if (occluded(scene, ray, t_max, light)) return Spectrum<N>(0.0);
   auto lookup = [&](double t) {
@@ -157,18 +161,21 @@ Spectrum<N> transmittance(const Scene& scene, const PathSpectra<N>& ps, const Ra
   };
   const bool residual =
       scene.settings.tracking.transmittance == TrackingSettings::Transmittance::ResidualRatio;
-  Spectrum<N> T(1.0);
+  Spectrum<N> T(channel < 0 ? 1.0 : 0.0);
+  if (channel >= 0) T[channel] = 1;
+  // The largest value over the tracked channels.
+  auto tracked_max = [&](const Spectrum<N>& x) { return channel < 0 ? x.max() : x[channel]; };
   walk_majorant_segments(scene, ps.ch, ray, 0, t_max, inside, [&](const MajorantSegment<N>& seg) {
     ++counters.majorant_segments;
     if (residual) {
       // The residual's rate must bound |mu_t − mu_c|; a scaled majorant may fall below mu_c.
-      double mu_bar_r = 0;
-      for (int c = 0; c < N; ++c)
-        mu_bar_r = std::max(mu_bar_r, std::abs(seg.mu_bar[c] - seg.mu_c[c]));
-      T = residual_ratio_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_c, mu_bar_r, rng,
+      Spectrum<N> gap;
+      for (int c = 0; c < N; ++c) gap[c] = std::abs(seg.mu_bar[c] - seg.mu_c[c]);
+      T = residual_ratio_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_c, tracked_max(gap), rng,
                                      counters.tracking, T);
     } else {
-      T = ratio_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_bar.max(), rng, counters.tracking, T);
+      T = ratio_tracking<N>(lookup, seg.t0, seg.t1, tracked_max(seg.mu_bar), rng, counters.tracking,
+                            T);
     }
     return !T.is_black();
   });
