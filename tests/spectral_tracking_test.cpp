@@ -106,7 +106,11 @@ Moments run(const Case& c, const Profile& p, uint64_t seed, TrackingCounters& co
   EventPolicy policy{c.rule, 0, c.absorption_events};
   auto lookup = [&](double t) { return p.at(t); };
   Moments mom;
-  for (int i = 0; i < kWalks; ++i) {
+  // The channel rule (delta tracking with weights) with a majorant that does not bound carries
+  // the excess in one channel, whose weights grow like ±((2 mu_t − mu_bar)/mu_bar)^k: at kWalks
+  // the 10 % denser medium stood only 2.9–3.5 standard errors off, so it gets 4 times as many.
+  const int walks = c.rule == EventRule::Channel && c.scale < 1 ? 4 * kWalks : kWalks;
+  for (int i = 0; i < walks; ++i) {
     policy.channel = i % 3;
     // The channel rule is delta tracking: its majorant is the tracked channel's.
     const double mu_bar = c.scale * (c.rule == EventRule::Channel ? p.majorant()[policy.channel]
@@ -150,12 +154,7 @@ std::vector<Case> cases() {
   for (EventRule rule : {EventRule::Channel, EventRule::Max, EventRule::History})
     for (bool collide : {true, false})
       for (bool decomposition : {false, true})
-        for (double scale : {1.0, 0.5})
-          // The channel rule (delta tracking) is unbiased with a majorant that does not bound
-          // too, but its weights then grow like ±((2 mu_t − mu_bar)/mu_bar)^k: too noisy to test
-          // at this count. The spectral rules spread the excess over all channels.
-          if (rule != EventRule::Channel || scale == 1)
-            out.push_back({rule, collide, decomposition, scale});
+        for (double scale : {1.0, 0.5}) out.push_back({rule, collide, decomposition, scale});
   return out;
 }
 

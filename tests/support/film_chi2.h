@@ -40,10 +40,13 @@ inline Chi2 film_chi2(const Film& a, const Film& b) {
   return c;
 }
 
-// A render against reference pixel values ref(pixel) (exact, or of negligible error).
-inline Chi2 film_chi2(const Film& a, const std::function<Rgb(int)>& ref) {
+// A render against reference pixel values ref(pixel) (exact, or of negligible error), over the
+// pixels where use(pixel) holds (all by default).
+inline Chi2 film_chi2(const Film& a, const std::function<Rgb(int)>& ref,
+                      const std::function<bool(int)>& use = {}) {
   Chi2 c;
   for (int p = 0; p < a.width * a.height; ++p) {
+    if (use && !use(p)) continue;
     const Rgb va = a.variance_of_mean(p), r = ref(p);
     for (int ch = 0; ch < 3; ++ch) add_z(c, a.mean(p)[ch] - r[ch], va[ch]);
   }
