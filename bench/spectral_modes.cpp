@@ -67,7 +67,7 @@ int main(int argc, char** argv) {
       sized.film.width = width;
       tracking = desc.integrator.tracking;
       const Scene scene = compile_scene(sized);
-      const RenderResult r = render(scene, {1, {}});
+      const RenderResult r = render(scene, RenderOptions{1, {}, {}, {}});
       const double samples = double(scene.settings.width) * scene.settings.height * spp;
       mode.seconds_per_sample.push_back(r.seconds / samples);
       Rgb var(0.0);

@@ -88,8 +88,8 @@ TEST(Render, ImageIsBitIdenticalForAnyThreadCount) {
   sun.direction = normalize(Vec3{-1, -1, -1});
   sun.emission = Rgb(2.0);
   scene.lights.push_back(sun);
-  const RenderResult one = render(scene, {1, {}});
-  const RenderResult two = render(scene, {2, {}});
+  const RenderResult one = render(scene, RenderOptions{1, {}, {}, {}});
+  const RenderResult two = render(scene, RenderOptions{2, {}, {}, {}});
   ASSERT_EQ(one.film.sum.size(), two.film.sum.size());
   for (size_t p = 0; p < one.film.sum.size(); ++p) {
     ASSERT_EQ(one.film.sum[p], two.film.sum[p]) << "pixel " << p;

@@ -316,8 +316,8 @@ TEST(SpectralRenderGrey, RgbAndSpectralModesAgree) {
 TEST(SpectralRenderGrey, SameImageForAnyThreadCount) {
   Scene scene = grey_scene(spectral(8));
   scene.settings.spp = 8;
-  const RenderResult one = render(scene, {1, {}});
-  const RenderResult two = render(scene, {2, {}});
+  const RenderResult one = render(scene, RenderOptions{1, {}, {}, {}});
+  const RenderResult two = render(scene, RenderOptions{2, {}, {}, {}});
   for (int p = 0; p < 64; ++p) EXPECT_TRUE(one.film.sum[p] == two.film.sum[p]) << p;
 }
 

@@ -1,16 +1,37 @@
 #include "nimbus/render/film.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <numeric>
+#include <stdexcept>
 
 namespace nimbus {
 
 Rgb Film::variance_of_mean(int pixel) const {
-  if (spp < 2) return Rgb(0.0);
+  const double n = samples[pixel];
+  if (n < 2) return Rgb(0.0);
   const Rgb m = mean(pixel);
-  Rgb var = (sum_sq[pixel] / double(spp) - m * m) * (double(spp) / double(spp - 1));
+  Rgb var = (sum_sq[pixel] / n - m * m) * (n / (n - 1));
   for (int c = 0; c < 3; ++c) var[c] = std::max(0.0, var[c]);
-  return var / double(spp);
+  return var / n;
+}
+
+void merge(Film& into, const Film& from) {
+  if (into.width != from.width || into.height != from.height)
+    throw std::invalid_argument(fmt::format("merging films of {}x{} and {}x{} pixels", into.width,
+                                            into.height, from.width, from.height));
+  for (int p = 0; p < into.pixels(); ++p) {
+    if (from.samples[p] == 0) continue;
+    if (into.samples[p] == 0) {
+      into.sum[p] = from.sum[p];
+      into.sum_sq[p] = from.sum_sq[p];
+    } else {
+      into.sum[p] += from.sum[p];
+      into.sum_sq[p] += from.sum_sq[p];
+    }
+    into.samples[p] += from.samples[p];
+  }
 }
 
 Image to_image(const Film& film) {

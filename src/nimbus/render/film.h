@@ -1,7 +1,15 @@
 #pragma once
-// Per-pixel sums and sums of squares of the sample values: mergeable (threads, processes) and
-// enough for the image and its standard error.
+// The state a render adds to: per pixel, the sum of the sample values, the sum of their squares
+// and the number of samples. Enough for the image and its standard error, and mergeable.
+//
+// Bit-identical however the work is split: each pixel's samples are added in sample order, so a
+// pixel's sums are the same bits whichever thread, call or process rendered it, as long as its
+// samples arrive in order. Pixels may be split between renders freely (merge takes a pixel that
+// the film has no samples of as it is), and a render may continue a pixel's samples where the
+// film left off (render_into checks that it does). Two films holding different samples of the
+// same pixel merge by adding their sums: the same expectation, not the same bits.
 
+#include <cstdint>
 #include <vector>
 
 #include "nimbus/io/image.h"
@@ -11,18 +19,29 @@ namespace nimbus {
 
 struct Film {
   int width = 0, height = 0;
-  long spp = 0;  // samples per pixel, the same for every pixel
   std::vector<Rgb> sum, sum_sq;
+  std::vector<uint32_t> samples;  // per pixel
 
-  Film(int w, int h) : width(w), height(h), sum(size_t(w) * h), sum_sq(size_t(w) * h) {}
+  Film() = default;
+  Film(int w, int h)
+      : width(w), height(h), sum(size_t(w) * h), sum_sq(size_t(w) * h), samples(size_t(w) * h, 0) {}
+  int pixels() const { return width * height; }
   void add(int pixel, const Rgb& value) {
     sum[pixel] += value;
     sum_sq[pixel] += value * value;
+    ++samples[pixel];
   }
-  Rgb mean(int pixel) const { return sum[pixel] / double(spp); }
-  // Variance of the pixel's mean estimate (sample variance / spp).
+  // The pixel's mean sample value; 0 for a pixel without samples.
+  Rgb mean(int pixel) const {
+    return samples[pixel] > 0 ? sum[pixel] / double(samples[pixel]) : Rgb(0.0);
+  }
+  // Variance of the pixel's mean estimate (sample variance / samples); 0 below 2 samples.
   Rgb variance_of_mean(int pixel) const;
 };
+
+// Adds `from` into `into` (films of one size, else std::invalid_argument): a pixel `into` has no
+// samples of takes `from`'s sums as they are; otherwise the sums and counts are added.
+void merge(Film& into, const Film& from);
 
 Image to_image(const Film& film);
 

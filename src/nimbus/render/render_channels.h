@@ -18,47 +18,57 @@
 
 namespace nimbus {
 
+// Adds the samples [range.s0, range.s1) of the pixels of `range` (resolved and checked by
+// render_into) to the film.
 template <int N>
-RenderResult render_channels(const Scene& scene, const RenderOptions& options, int threads) {
-  const int W = scene.settings.width, H = scene.settings.height, spp = scene.settings.spp;
-  RenderResult result{Film(W, H), {}, 0, threads};
-  result.film.spp = spp;
+RenderStats render_channels(const Scene& scene, Film& film, const RenderRange& range,
+                            const RenderOptions& options, int threads) {
+  const int W = scene.settings.width;
+  RenderStats stats;
+  stats.threads = threads;
   tbb::enumerable_thread_specific<Counters> counters;
   tbb::enumerable_thread_specific<PathSpectra<N>> spectra;
   const bool spectral = scene.settings.spectral.mode == SpectralSettings::Mode::Spectral;
+  const double range_pixels = double(range.x1 - range.x0) * double(range.y1 - range.y0);
   std::atomic<long> pixels_done{0};
+  std::atomic<bool> cancelled{false};
   std::mutex progress_mutex;
   const auto start = std::chrono::steady_clock::now();
 
   constexpr int kTile = 16;
   tbb::parallel_for(
-      tbb::blocked_range2d<int>(0, H, kTile, 0, W, kTile),
+      tbb::blocked_range2d<int>(range.y0, range.y1, kTile, range.x0, range.x1, kTile),
       [&](const tbb::blocked_range2d<int>& tile) {
+        if (cancelled || (options.cancel && options.cancel())) {
+          cancelled = true;
+          return;
+        }
         Counters& local = counters.local();
         PathSpectra<N>& ps = spectra.local();
         if (!spectral) prepare_path_spectra(ps, scene, 0.0);
         for (int y = tile.rows().begin(); y < tile.rows().end(); ++y)
           for (int x = tile.cols().begin(); x < tile.cols().end(); ++x) {
             const int pixel = y * W + x;
-            for (int s = 0; s < spp; ++s) {
+            for (int s = range.s0; s < range.s1; ++s) {
               Rng rng = Rng::for_sample(scene.settings.seed, uint64_t(pixel), uint64_t(s));
               const double u1 = rng.uniform(), u2 = rng.uniform();
               const Ray ray = scene.camera.generate(x + u1, y + u2);
               if (spectral) prepare_path_spectra(ps, scene, rng.uniform());
               const Spectrum<N> L = radiance(scene, ps, ray, rng, local);
-              result.film.add(pixel, to_film_rgb(L, ps.ch));
+              film.add(pixel, to_film_rgb(L, ps.ch));
             }
           }
         const long done = pixels_done += long(tile.rows().size()) * long(tile.cols().size());
         if (options.progress && progress_mutex.try_lock()) {
-          options.progress(double(done) / (double(W) * H));
+          options.progress(double(done) / range_pixels);
           progress_mutex.unlock();
         }
       });
 
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  for (const Counters& c : counters) result.counters += c;
-  return result;
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (const Counters& c : counters) stats.counters += c;
+  stats.cancelled = cancelled;
+  return stats;
 }
 
 }  // namespace nimbus

@@ -1,5 +1,6 @@
 #include "nimbus/render/renderer.h"
 
+#include <fmt/format.h>
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
@@ -10,33 +11,70 @@ namespace nimbus {
 
 // Instantiated in generated translation units (CMakeLists.txt, render_channels.cpp.in).
 template <int N>
-RenderResult render_channels(const Scene& scene, const RenderOptions& options, int threads);
+RenderStats render_channels(const Scene& scene, Film& film, const RenderRange& range,
+                            const RenderOptions& options, int threads);
 
 namespace {
 
 template <int N>
-RenderResult dispatch(const Scene& scene, const RenderOptions& options, int threads, int n) {
+RenderStats dispatch(const Scene& scene, Film& film, const RenderRange& range,
+                     const RenderOptions& options, int threads, int n) {
   if constexpr (N > kMaxWavelengths) {
     throw std::invalid_argument("spectral mode: " + std::to_string(n) + " wavelengths");
   } else {
-    if (n == N) return render_channels<N>(scene, options, threads);
-    return dispatch<N + 1>(scene, options, threads, n);
+    if (n == N) return render_channels<N>(scene, film, range, options, threads);
+    return dispatch<N + 1>(scene, film, range, options, threads, n);
   }
+}
+
+// The range with its open ends resolved, checked against the film.
+RenderRange resolve(const Scene& scene, const Film& film, RenderRange r) {
+  const int W = scene.settings.width, H = scene.settings.height;
+  if (film.width != W || film.height != H)
+    throw std::invalid_argument(fmt::format("the film is {}x{} pixels, the scene's image {}x{}",
+                                            film.width, film.height, W, H));
+  if (r.x1 < 0) r.x1 = W;
+  if (r.y1 < 0) r.y1 = H;
+  if (r.s1 < 0) r.s1 = scene.settings.spp;
+  if (r.x0 < 0 || r.y0 < 0 || r.x0 > r.x1 || r.y0 > r.y1 || r.x1 > W || r.y1 > H)
+    throw std::invalid_argument(fmt::format("pixels [{}, {}) x [{}, {}) are not within {}x{}", r.x0,
+                                            r.x1, r.y0, r.y1, W, H));
+  if (r.s0 < 0 || r.s0 > r.s1)
+    throw std::invalid_argument(fmt::format("samples [{}, {}) are not a range", r.s0, r.s1));
+  for (int y = r.y0; y < r.y1; ++y)
+    for (int x = r.x0; x < r.x1; ++x)
+      if (film.samples[size_t(y) * W + x] != uint32_t(r.s0))
+        throw std::invalid_argument(
+            fmt::format("pixel ({}, {}) holds {} samples; samples [{}, {}) continue from {}", x, y,
+                        film.samples[size_t(y) * W + x], r.s0, r.s1, r.s0));
+  return r;
 }
 
 }  // namespace
 
-RenderResult render(const Scene& scene, const RenderOptions& options) {
+RenderStats render_into(const Scene& scene, Film& film, const RenderOptions& options) {
+  const RenderRange range = resolve(scene, film, options.range);
   const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
   if (scene.settings.spectral.mode == SpectralSettings::Mode::Rgb)
-    return render_channels<3>(scene, options, threads);
+    return render_channels<3>(scene, film, range, options, threads);
   const int n = scene.settings.spectral.wavelengths;
   if (n < kMinWavelengths || n > kMaxWavelengths)
     throw std::invalid_argument("spectral mode needs " + std::to_string(kMinWavelengths) + " to " +
                                 std::to_string(kMaxWavelengths) + " wavelengths, not " +
                                 std::to_string(n));
-  return dispatch<kMinWavelengths>(scene, options, threads, n);
+  return dispatch<kMinWavelengths>(scene, film, range, options, threads, n);
+}
+
+RenderResult render(const Scene& scene, const RenderOptions& options) {
+  RenderResult result;
+  result.film = Film(scene.settings.width, scene.settings.height);
+  const RenderStats s = render_into(scene, result.film, options);
+  result.counters = s.counters;
+  result.seconds = s.seconds;
+  result.threads = s.threads;
+  result.cancelled = s.cancelled;
+  return result;
 }
 
 }  // namespace nimbus

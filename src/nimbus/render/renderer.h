@@ -1,7 +1,8 @@
 #pragma once
 // Renders a compiled scene over tiles in parallel (oneTBB). Each pixel sample draws from its own
-// random stream keyed by (seed, pixel, sample index) and each pixel is summed in sample order, so
-// the image is bit-identical for any thread count.
+// random stream keyed by (seed, pixel, sample index) and each pixel's samples are added to the
+// film in sample order, so the image is bit-identical for any thread count, and for any split of
+// the pixels, or of the samples into consecutive ranges, between renders (render/film.h).
 
 #include <functional>
 
@@ -11,19 +12,43 @@
 
 namespace nimbus {
 
+// The part of the work a render does: the pixels [x0, x1) × [y0, y1) and, for each, the samples
+// with indices [s0, s1). An end of -1 means the film's edge (x1, y1) or the scene's spp (s1).
+struct RenderRange {
+  int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+  int s0 = 0, s1 = -1;
+};
+
 struct RenderOptions {
   int threads = 0;  // 0: all hardware threads
-  // Called now and then with the fraction done, from one thread at a time.
+  // Called now and then with the fraction of the range done, from one thread at a time.
   std::function<void(double)> progress;
+  RenderRange range;
+  // Polled before each tile, possibly from several threads at once; once it returns true no
+  // tile starts: every pixel then holds either all of the range's samples or none of them.
+  std::function<bool()> cancel;
 };
+
+struct RenderStats {
+  Counters counters;
+  double seconds = 0;
+  int threads = 0;
+  bool cancelled = false;
+};
+
+// Adds the samples of options.range to `film`, which must have the scene's size and hold exactly
+// range.s0 samples in every pixel of the range (else std::invalid_argument, naming the pixel).
+RenderStats render_into(const Scene& scene, Film& film, const RenderOptions& options = {});
 
 struct RenderResult {
   Film film;
   Counters counters;
   double seconds = 0;
   int threads = 0;
+  bool cancelled = false;
 };
 
+// render_into a fresh film.
 RenderResult render(const Scene& scene, const RenderOptions& options = {});
 
 }  // namespace nimbus

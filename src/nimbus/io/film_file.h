@@ -1,0 +1,19 @@
+#pragma once
+// A film (render/film.h) in a file, to resume or extend a render and to merge renders made
+// elsewhere.
+
+#include <string>
+
+#include "nimbus/render/film.h"
+
+namespace nimbus {
+
+// Saves the film to a file, atomically (io/atomic_file.h): a versioned little-endian binary of
+// the size, then per pixel the count, the three sums and the three sums of squares.
+void save_film(const Film& film, const std::string& path);
+
+// Loads a film saved by save_film; std::runtime_error("PATH: problem") if the file is missing,
+// not a film, of another version, cut short or followed by other bytes.
+Film load_film(const std::string& path);
+
+}  // namespace nimbus

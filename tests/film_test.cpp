@@ -1,0 +1,195 @@
+// The mergeable film and the render over a range of pixels and samples (issue 12): however the
+// pixels are split, and whenever samples continue in order, the film is the same bits as one
+// render; films round-trip through files; bad ranges and bad files are refused with one line.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+#include "nimbus/frep/primitives.h"
+#include "nimbus/io/film_file.h"
+#include "nimbus/render/renderer.h"
+#include "support/scene_builders.h"
+
+namespace nimbus {
+namespace {
+
+// A cloud in a sphere under a sun and a sky: media, shadow rays and surfaces-free paths.
+Scene small_scene(int spp) {
+  Scene scene;
+  scene.settings = {37,
+                    23,
+                    spp,
+                    9,
+                    100,
+                    test::tracking_settings(TrackingSettings::Mode::SpectralMis,
+                                            TrackingSettings::Absorption::Collide, false, 4),
+                    {}};
+  scene.camera = perspective_camera({0, 0.5, 3.2}, {0, 0, 0}, {0, 1, 0}, 45, 37, 23);
+  Light sun;
+  sun.type = Light::Type::Directional;
+  sun.direction = normalize(Vec3{-0.4, -1, -0.3});
+  sun.emission = Rgb(3.0);
+  scene.lights.push_back(sun);
+  scene.lights.push_back(test::environment(0.3));
+  Medium cloud;
+  cloud.density = Medium::Density::Cloud;
+  cloud.sigma_s = Rgb({4.0, 6.0, 8.0});
+  cloud.sigma_a = Rgb(0.2);
+  cloud.cloud = make_cloud_density(CloudParams{});
+  scene.media.push_back(cloud);
+  scene.objects.push_back(
+      test::object_of(make_shape(QuadricNode{sphere({0, 0, 0}, 1)}), Surface::Type::None, 0));
+  test::finish_media(scene);
+  return scene;
+}
+
+void expect_same_bits(const Film& a, const Film& b) {
+  ASSERT_EQ(a.width, b.width);
+  ASSERT_EQ(a.height, b.height);
+  for (int p = 0; p < a.pixels(); ++p) {
+    ASSERT_EQ(a.samples[p], b.samples[p]) << p;
+    ASSERT_TRUE(a.sum[p] == b.sum[p]) << p;
+    ASSERT_TRUE(a.sum_sq[p] == b.sum_sq[p]) << p;
+  }
+}
+
+RenderOptions range(int x0, int y0, int x1, int y1, int s0, int s1, int threads = 0) {
+  RenderOptions o;
+  o.threads = threads;
+  o.range = {x0, y0, x1, y1, s0, s1};
+  return o;
+}
+
+TEST(Film, PixelSplitsAndSampleContinuationsGiveTheSameBits) {
+  const Scene scene = small_scene(6);
+  const Film whole = render(scene).film;
+  for (int p = 0; p < whole.pixels(); ++p) ASSERT_EQ(whole.samples[p], 6u);
+
+  // Four uneven pixel blocks into one film, on different thread counts.
+  Film blocks(37, 23);
+  render_into(scene, blocks, range(0, 0, 20, 11, 0, -1, 1));
+  render_into(scene, blocks, range(20, 0, 37, 11, 0, -1, 2));
+  render_into(scene, blocks, range(0, 11, 5, 23, 0, -1, 2));
+  render_into(scene, blocks, range(5, 11, 37, 23, 0, -1, 1));
+  expect_same_bits(whole, blocks);
+
+  // Samples [0, 2), then [2, 6), into the same film.
+  Film continued(37, 23);
+  render_into(scene, continued, range(0, 0, -1, -1, 0, 2));
+  render_into(scene, continued, range(0, 0, -1, -1, 2, 6));
+  expect_same_bits(whole, continued);
+
+  // Disjoint pixel blocks in separate films (separate processes), merged.
+  Film left(37, 23), right(37, 23), merged(37, 23);
+  render_into(scene, left, range(0, 0, 18, 23, 0, -1));
+  render_into(scene, right, range(18, 0, 37, 23, 0, -1));
+  merge(merged, right);
+  merge(merged, left);
+  expect_same_bits(whole, merged);
+}
+
+TEST(Film, MergingTwoSampleRangesOfAPixelAddsThem) {
+  const Scene scene = small_scene(6);
+  Film a(37, 23), b(37, 23);
+  render_into(scene, a, range(0, 0, -1, -1, 0, 2));
+  render_into(scene, b, range(0, 0, -1, -1, 0, 4));
+  Film m = a;
+  merge(m, b);
+  for (int p = 0; p < m.pixels(); ++p) {
+    EXPECT_EQ(m.samples[p], 6u);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(m.sum[p][c], a.sum[p][c] + b.sum[p][c]);
+      EXPECT_EQ(m.sum_sq[p][c], a.sum_sq[p][c] + b.sum_sq[p][c]);
+    }
+  }
+  EXPECT_THROW(merge(m, Film(36, 23)), std::invalid_argument);
+}
+
+TEST(Film, RangesThatDoNotContinueAreRefused) {
+  const Scene scene = small_scene(4);
+  Film film(37, 23);
+  auto message = [&](const RenderOptions& o, Film& f) {
+    try {
+      render_into(scene, f, o);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message(range(0, 0, -1, -1, 2, 4), film),
+            "pixel (0, 0) holds 0 samples; samples [2, 4) continue from 2");
+  Film wrong(10, 10);
+  EXPECT_EQ(message({}, wrong), "the film is 10x10 pixels, the scene's image 37x23");
+  EXPECT_EQ(message(range(0, 0, 38, 5, 0, -1), film),
+            "pixels [0, 38) x [0, 5) are not within 37x23");
+  EXPECT_EQ(message(range(0, 0, -1, -1, 3, 2), film), "samples [3, 2) are not a range");
+  for (int p = 0; p < film.pixels(); ++p) EXPECT_EQ(film.samples[p], 0u) << "nothing rendered";
+}
+
+TEST(Film, CancelledRendersLeaveWholePixelsOnly) {
+  const Scene scene = small_scene(4);
+  Film film(37, 23);
+  std::atomic<int> polls{0};
+  RenderOptions o = range(0, 0, -1, -1, 0, -1, 1);
+  o.cancel = [&] { return ++polls > 2; };  // two tiles, then stop
+  const RenderStats s = render_into(scene, film, o);
+  EXPECT_TRUE(s.cancelled);
+  int done = 0;
+  for (int p = 0; p < film.pixels(); ++p) {
+    EXPECT_TRUE(film.samples[p] == 0 || film.samples[p] == 4) << p;
+    done += film.samples[p] == 4;
+  }
+  EXPECT_GT(done, 0);
+  EXPECT_LT(done, film.pixels());
+  // The rest can be rendered later: the pixels still at 0 continue from 0.
+  EXPECT_FALSE(render_into(scene, film, range(20, 16, 37, 23, 0, -1)).cancelled);
+}
+
+TEST(Film, RoundTripsThroughAFile) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "nimbus_film_test";
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "a.film").string();
+  Film film = render(small_scene(3)).film;
+  film.samples[5] = 0;  // counts per pixel survive too
+  save_film(film, path);
+  expect_same_bits(film, load_film(path));
+
+  auto message = [&](const std::string& p) {
+    try {
+      load_film(p);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message((dir / "missing.film").string()),
+            (dir / "missing.film").string() + ": cannot open the film file");
+  const std::string bad = (dir / "bad.film").string();
+  std::ofstream(bad) << "{\"not\": \"a film\"}";
+  EXPECT_EQ(message(bad), bad + ": not a nimbus film file");
+  const auto size = std::filesystem::file_size(path);
+  std::filesystem::copy_file(path, bad, std::filesystem::copy_options::overwrite_existing);
+  std::filesystem::resize_file(bad, size - 1);
+  EXPECT_EQ(message(bad), bad + ": the film file is cut short");
+  std::filesystem::copy_file(path, bad, std::filesystem::copy_options::overwrite_existing);
+  std::ofstream(bad, std::ios::app) << 'x';
+  EXPECT_EQ(message(bad), bad + ": trailing bytes after the film");
+  std::filesystem::copy_file(path, bad, std::filesystem::copy_options::overwrite_existing);
+  {
+    std::fstream f(bad, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(8);
+    const uint32_t version = 99;
+    f.write(reinterpret_cast<const char*>(&version), sizeof version);
+  }
+  EXPECT_EQ(message(bad), bad + ": film file version 99, this nimbus reads 1");
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace nimbus
