@@ -14,7 +14,7 @@ Vec3 random_point(Rng& rng, double r) {
 }
 
 TEST(CloudDensity, ZeroWhereFIsNotPositiveAndWithinUnitInterval) {
-  const CloudDensity cloud = make_cloud_density({});
+  const CloudNoise cloud = make_cloud_noise({});
   Rng rng(1);
   for (int i = 0; i < 20000; ++i) {
     const Vec3 x = random_point(rng, 1.5);
@@ -31,7 +31,7 @@ TEST(CloudDensity, ZeroWhereFIsNotPositiveAndWithinUnitInterval) {
 }
 
 TEST(CloudDensity, NonDecreasingInF) {
-  const CloudDensity cloud = make_cloud_density({.octaves = 4, .amplitude = 0.7, .seed = 3});
+  const CloudNoise cloud = make_cloud_noise({.octaves = 4, .amplitude = 0.7, .seed = 3});
   Rng rng(2);
   int increases = 0;
   for (int i = 0; i < 2000; ++i) {
@@ -54,7 +54,7 @@ TEST(CloudDensity, RangeContainsSampledDensities) {
   for (const CloudParams params :
        {CloudParams{},
         CloudParams{.octaves = 2, .frequency = 5, .amplitude = 0.3, .seed = 9, .edge = 0.5}}) {
-    const CloudDensity cloud = make_cloud_density(params);
+    const CloudNoise cloud = make_cloud_noise(params);
     Rng rng(params.seed, 4);
     int strictly_inside = 0;
     for (int i = 0; i < 50000; ++i) {
@@ -84,7 +84,7 @@ TEST(CloudDensity, RangeIsTightAtTheEnds) {
 TEST(CloudDensity, ErodedEdgeHasHolesAndDenseCore) {
   // On the unit sphere with F = 1 − |x|², amplitude 0.6: between radii 0.75 and 0.95 some
   // points are empty and some are not (billowy edge with holes); near the centre all are dense.
-  const CloudDensity cloud = make_cloud_density({});
+  const CloudNoise cloud = make_cloud_noise({});
   Rng rng(7);
   int empty_shell = 0, full_shell = 0, thin_core = 0;
   for (int i = 0; i < 20000; ++i) {

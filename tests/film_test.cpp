@@ -13,6 +13,7 @@
 
 #include "nimbus/frep/primitives.h"
 #include "nimbus/io/film_file.h"
+#include "nimbus/media/cloud_density.h"
 #include "nimbus/render/renderer.h"
 #include "support/scene_builders.h"
 
@@ -38,10 +39,9 @@ Scene small_scene(int spp) {
   scene.lights.push_back(sun);
   scene.lights.push_back(test::environment(0.3));
   Medium cloud;
-  cloud.density = Medium::Density::Cloud;
   cloud.sigma_s = Rgb({4.0, 6.0, 8.0});
   cloud.sigma_a = Rgb(0.2);
-  cloud.cloud = make_cloud_density(CloudParams{});
+  cloud.density = make_cloud_density(CloudParams{});
   scene.media.push_back(cloud);
   scene.objects.push_back(
       test::object_of(make_shape(QuadricNode{sphere({0, 0, 0}, 1)}), Surface::Type::None, 0));

@@ -15,6 +15,8 @@
 
 #include "nimbus/frep/primitives.h"
 #include "nimbus/math/constants.h"
+#include "nimbus/media/cloud_density.h"
+#include "nimbus/media/field_density.h"
 #include "nimbus/render/renderer.h"
 #include "support/chandrasekhar.h"
 #include "support/film_chi2.h"
@@ -189,7 +191,7 @@ RenderResult render_absorber(const TrackingSettings& tracking, double density) {
   Medium absorber;
   absorber.sigma_a = kAbsorberSigmaA;
   absorber.emission = kAbsorberLe;
-  absorber.density = Medium::Density::Field;
+  absorber.density = make_field_density();
   absorber.scale = density;
   scene.media.push_back(absorber);
   scene.objects.push_back(
@@ -299,9 +301,8 @@ Medium chromatic_scatterer() {
 
 Medium chromatic_cloud_medium(const Rgb& sigma_s) {
   Medium cloud = chromatic_scatterer();
-  cloud.density = Medium::Density::Cloud;
   cloud.sigma_s = sigma_s;
-  cloud.cloud = make_cloud_density(CloudParams{});
+  cloud.density = make_cloud_density(CloudParams{});
   return cloud;
 }
 
@@ -404,7 +405,7 @@ Scene single_scattering_scene(const TrackingSettings& tracking, double more_scat
   m.sigma_a = kSingleSigmaA - kSingleSigmaS * more_scattering;
   m.sigma_s = kSingleSigmaS * (1 + more_scattering);
   m.g = kSingleG;
-  m.density = Medium::Density::Field;
+  m.density = make_field_density();
   scene.media.push_back(m);
   scene.objects.push_back(test::object_of(unit_sphere(), Surface::Type::None, 0));
   test::finish_media(scene);

@@ -12,6 +12,8 @@
 #include "nimbus/frep/primitives.h"
 #include "nimbus/frep/tape.h"
 #include "nimbus/math/rng.h"
+#include "nimbus/media/cloud_density.h"
+#include "nimbus/media/field_density.h"
 #include "nimbus/media/medium_field.h"
 #include "nimbus/render/path_spectra.h"
 #include "nimbus/render/scene.h"
@@ -38,12 +40,11 @@ Scene three_media(int depth) {
   scene.settings.tracking.octree_depth = depth;
   Medium cloud;
   cloud.sigma_s = Rgb({4.0, 8.0, 12.0});
-  cloud.density = Medium::Density::Cloud;
-  cloud.cloud = make_cloud_density(CloudParams{});
+  cloud.density = make_cloud_density(CloudParams{});
   add_field_object(scene, make_shape(QuadricNode{sphere({0, 0, 0}, 1)}), cloud);
   Medium field;
   field.sigma_a = Rgb({1.0, 2.0, 3.0});
-  field.density = Medium::Density::Field;
+  field.density = make_field_density();
   field.scale = 2;
   add_field_object(scene, make_shape(QuadricNode{ellipsoid({0.9, 0.2, 0}, {1, 0.5, 0.7})}), field);
   Medium constant;
@@ -309,13 +310,12 @@ TEST(Octree, SampledBoundsNeverHideMedium) {
   Medium cloud;
   cloud.sigma_a = Rgb({0.1, 0.05, 0.2});
   cloud.sigma_s = Rgb({8.0, 24.0, 16.0});
-  cloud.density = Medium::Density::Cloud;
   CloudParams params;
   params.octaves = 4;
   params.frequency = 2;
   params.amplitude = 0.6;
   params.seed = 3;
-  cloud.cloud = make_cloud_density(params);
+  cloud.density = make_cloud_density(params);
   add_field_object(scene, make_shape(QuadricNode{sphere({0, 0, 0}, 1)}), cloud);
   build_majorant_octrees(scene);
   const MajorantOctree& bound = scene.field_octree;

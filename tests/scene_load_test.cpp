@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "nimbus/frep/primitives.h"
+#include "nimbus/media/cloud_density.h"
+#include "nimbus/media/field_density.h"
 #include "nimbus/scene/load.h"
 #include "nimbus/spectral/color.h"
 
@@ -399,15 +401,16 @@ TEST(SceneLoad, ExampleLoads) {
   EXPECT_EQ(s.media[0].name, "cloud");
   EXPECT_EQ(s.media[0].phase.type, PhaseDesc::Type::HenyeyGreenstein);
   EXPECT_EQ(s.media[0].phase.g, 0.85);
-  EXPECT_EQ(s.media[0].density.type, DensityDesc::Type::Cloud);
-  EXPECT_EQ(s.media[0].density.seed, 7u);
+  const auto* cloud = dynamic_cast<const CloudDensity*>(s.media[0].density.get());
+  ASSERT_NE(cloud, nullptr);
+  EXPECT_EQ(cloud->params().seed, 7u);
   EXPECT_EQ(s.media[1].name, "fire");
   EXPECT_EQ(s.media[1].emission.rgb, Rgb({4, 1.5, 0.2}));
   EXPECT_EQ(s.media[1].phase.type, PhaseDesc::Type::Isotropic);
   EXPECT_EQ(s.media[2].name, "haze");
   EXPECT_EQ(s.media[2].sigma_a.rgb, Rgb(0.05));
-  EXPECT_EQ(s.media[2].density.type, DensityDesc::Type::Field);
-  EXPECT_EQ(s.media[2].density.scale, 2.0);
+  EXPECT_NE(dynamic_cast<const FieldDensity*>(s.media[2].density.get()), nullptr);
+  EXPECT_EQ(s.media[2].density_scale, 2.0);
   EXPECT_EQ(s.media[3].name, "marble");
 
   ASSERT_EQ(s.objects.size(), 4u);
@@ -501,8 +504,8 @@ TEST(SceneLoad, DefaultsApplyWhereKeysAreOptional) {
   EXPECT_TRUE(s.lights.empty());
   ASSERT_EQ(s.media.size(), 1u);
   EXPECT_TRUE(s.media[0].sigma_s.rgb.is_black());
-  EXPECT_EQ(s.media[0].density.type, DensityDesc::Type::Constant);
-  EXPECT_EQ(s.media[0].density.scale, 1.0);
+  EXPECT_NE(dynamic_cast<const ConstantDensity*>(s.media[0].density.get()), nullptr);
+  EXPECT_EQ(s.media[0].density_scale, 1.0);
   EXPECT_EQ(s.objects[0].shape_name, "inline");
   EXPECT_EQ(s.objects[0].surface.type, SurfaceDesc::Type::Diffuse);
   EXPECT_EQ(s.objects[0].surface.albedo.rgb, Rgb(0.5));

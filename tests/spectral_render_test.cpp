@@ -14,6 +14,7 @@
 
 #include "nimbus/frep/primitives.h"
 #include "nimbus/math/constants.h"
+#include "nimbus/media/cloud_density.h"
 #include "nimbus/render/renderer.h"
 #include "nimbus/spectral/cie.h"
 #include "nimbus/spectral/color.h"
@@ -160,8 +161,7 @@ TEST_P(SpectralRender, EmissiveFurnaceIsInEquilibrium) {
   m.sigma_s = Rgb({4.0, 1.0, 6.0});
   m.sigma_a = Rgb({2.0, 4.0, 0.5});
   m.emission = Rgb(1.0);
-  m.density = Medium::Density::Cloud;
-  m.cloud = make_cloud_density(CloudParams{});
+  m.density = make_cloud_density(CloudParams{});
   const Scene scene = furnace_scene(c, m, 6, 512);
   SKIP_IF_UNFIT(scene, false);
   const RenderResult r = render(scene);
@@ -270,8 +270,7 @@ Scene grey_scene(const SpectralSettings& spectrum, double light_scale = 1) {
   Medium cloud;
   cloud.sigma_s = Rgb(3.0);
   cloud.sigma_a = Rgb(0.5);
-  cloud.density = Medium::Density::Cloud;
-  cloud.cloud = make_cloud_density(CloudParams{});
+  cloud.density = make_cloud_density(CloudParams{});
   scene.media.push_back(cloud);
   scene.objects.push_back(
       test::object_of(make_shape(QuadricNode{sphere({0, 0.2, 0}, 1)}), Surface::Type::None, 0));

@@ -23,11 +23,15 @@ double noise01(double n) {
 
 }  // namespace
 
-CloudDensity make_cloud_density(const CloudParams& params) {
+CloudNoise make_cloud_noise(const CloudParams& params) {
   return {params, make_noise(params.seed)};
 }
 
-double cloud_density(const CloudDensity& cloud, const Vec3& x, double F) {
+DensityPtr make_cloud_density(const CloudParams& params) {
+  return std::make_shared<CloudDensity>(params);
+}
+
+double cloud_density(const CloudNoise& cloud, const Vec3& x, double F) {
   const CloudParams& p = cloud.params;
   const double s = profile(F, p.edge);
   if (s <= 0) return 0;

@@ -24,6 +24,7 @@
 #include <utility>
 
 #include "nimbus/math/vec3.h"
+#include "nimbus/media/density.h"
 #include "nimbus/media/noise.h"
 
 namespace nimbus {
@@ -41,17 +42,35 @@ inline constexpr double kCloudContrast = 1.6;  // gain of fbm before mapping to 
 inline constexpr int kCloudWarpOctaves = 2;
 
 // Parameters plus the noise tables built from the seed, ready to evaluate.
-struct CloudDensity {
+struct CloudNoise {
   CloudParams params;
   Noise noise;
 };
 
-CloudDensity make_cloud_density(const CloudParams& params);
+CloudNoise make_cloud_noise(const CloudParams& params);
 
 // The density d(x, F) above, in [0, 1].
-double cloud_density(const CloudDensity& cloud, const Vec3& x, double F);
+double cloud_density(const CloudNoise& cloud, const Vec3& x, double F);
 
 // A conservative [min, max] of cloud_density over any region where F ∈ [F_lo, F_hi].
 std::pair<double, double> cloud_density_range(double F_lo, double F_hi, const CloudParams& params);
+
+// The cloud as a medium's density (density.h).
+class CloudDensity final : public Density {
+ public:
+  explicit CloudDensity(const CloudParams& params) : cloud_(make_cloud_noise(params)) {}
+  bool uses_F() const override { return true; }
+  double value(const Vec3& x, double F) const override { return cloud_density(cloud_, x, F); }
+  Interval range(const Box&, const Interval& F) const override {
+    const auto [lo, hi] = cloud_density_range(F.lo, F.hi, cloud_.params);
+    return {lo, hi};
+  }
+  const CloudParams& params() const { return cloud_.params; }
+
+ private:
+  CloudNoise cloud_;
+};
+
+DensityPtr make_cloud_density(const CloudParams& params);
 
 }  // namespace nimbus

@@ -43,7 +43,7 @@ void for_each_medium_at(const Scene& scene, const Vec3& x, int inside, F&& f) {
     const SceneObject& obj = scene.objects[inside];
     if (obj.medium < 0) return;
     const Medium& medium = scene.media[obj.medium];
-    const double F_x = medium.density == Medium::Density::Constant ? 1.0 : evaluate(obj.tape, x);
+    const double F_x = medium.density->uses_F() ? evaluate(obj.tape, x) : 1.0;
     const double d = medium_density(medium, x, F_x);
     if (d > 0) f(obj.medium, d);
     return;

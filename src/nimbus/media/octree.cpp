@@ -47,30 +47,18 @@ std::vector<std::vector<double>> sigma_t_bins(const Scene& scene, int bins) {
   return out;
 }
 
-// The density range of one member over a box, from the interval of F. Inside a solid, a
-// constant medium is constant wherever the ray can be (medium_at ignores F there).
+// The density range of one member over a box, from the interval of F. Inside a solid the medium
+// fills the object wherever the ray can be.
 bool density_range(const Member& m, const Box& box, bool solid, double& lo, double& hi) {
   const Box b = intersect(m.object->bounds, box);
   if (b.empty()) return false;  // medium_at only looks at objects whose bounds hold the point
   const Interval F = evaluate(m.object->tape, b);
   if (!(F.hi > 0)) return false;
   const Medium& med = *m.medium;
-  switch (med.density) {
-    case Medium::Density::Constant:
-      lo = solid || F.lo > 0 ? med.scale : 0.0;
-      hi = med.scale;
-      break;
-    case Medium::Density::Field:
-      lo = med.scale * std::max(F.lo, 0.0);
-      hi = med.scale * F.hi;
-      break;
-    case Medium::Density::Cloud: {
-      const auto [a, b2] = cloud_density_range(F.lo, F.hi, med.cloud.params);
-      lo = med.scale * a;
-      hi = med.scale * b2;
-      break;
-    }
-  }
+  const Interval r = med.density->range(b, F);
+  // Outside a solid the medium is present only where F > 0.
+  lo = solid || F.lo > 0 ? med.scale * r.lo : 0.0;
+  hi = med.scale * r.hi;
   // Where the box reaches past the object's bounds there are points without this medium.
   if (!(b.lo == box.lo && b.hi == box.hi)) lo = 0;
   return true;

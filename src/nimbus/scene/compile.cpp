@@ -89,25 +89,8 @@ Medium compile_medium(const MediumDesc& d) {
   m.sigma_s = d.sigma_s;
   m.emission = d.emission;
   m.g = d.phase.type == PhaseDesc::Type::HenyeyGreenstein ? d.phase.g : 0.0;
-  switch (d.density.type) {
-    case DensityDesc::Type::Constant:
-      m.density = Medium::Density::Constant;
-      break;
-    case DensityDesc::Type::Field:
-      m.density = Medium::Density::Field;
-      break;
-    case DensityDesc::Type::Cloud:
-      m.density = Medium::Density::Cloud;
-      break;
-  }
-  m.scale = d.density.scale;
-  CloudParams cp;
-  cp.octaves = d.density.octaves;
-  cp.frequency = d.density.frequency;
-  cp.amplitude = d.density.amplitude;
-  cp.seed = d.density.seed;
-  cp.edge = d.density.edge;
-  m.cloud = make_cloud_density(cp);
+  m.density = d.density;
+  m.scale = d.density_scale;
   return m;
 }
 

@@ -13,6 +13,7 @@
 #include "nimbus/frep/primitives.h"
 #include "nimbus/media/octree.h"
 #include "nimbus/render/scene.h"
+#include "nimbus/scene/density_types.h"
 
 namespace nimbus {
 namespace {
@@ -274,21 +275,11 @@ class Loader {
     if (auto x = o.optional("density")) {
       JsonObject d(*x);
       std::string type = "constant";
-      if (auto t = d.optional("type")) {
-        type = string_choice(*t, "density type", {"constant", "field", "cloud"});
-        m.density.type = type == "constant" ? DensityDesc::Type::Constant
-                         : type == "field"  ? DensityDesc::Type::Field
-                                            : DensityDesc::Type::Cloud;
-      }
-      if (auto s = d.optional("scale")) m.density.scale = s->number(at_least(0));
-      if (m.density.type == DensityDesc::Type::Cloud) {
-        if (auto y = d.optional("octaves")) m.density.octaves = y->integer(between(1, 16));
-        if (auto y = d.optional("frequency")) m.density.frequency = y->number(above(0));
-        if (auto y = d.optional("amplitude"))
-          m.density.amplitude = y->number(Range{0.0, 1.0, false, true});
-        if (auto y = d.optional("edge")) m.density.edge = y->number(above(0));
-        if (auto y = d.optional("seed")) m.density.seed = y->unsigned_integer();
-      }
+      if (auto t = d.optional("type"))
+        type = string_choice(*t, "density type", density_type_names());
+      if (auto s = d.optional("scale")) m.density_scale = s->number(at_least(0));
+      for (const DensityType& t : density_types())
+        if (t.name == type) m.density = t.read(d);
       d.finish(fmt::format("for density type \"{}\"", type));
     }
     o.finish();

@@ -9,6 +9,8 @@
 
 #include "nimbus/frep/shape_desc.h"
 #include "nimbus/math/vec3.h"
+#include "nimbus/media/constant_density.h"
+#include "nimbus/media/density.h"
 #include "nimbus/spectral/spectral_param.h"
 
 namespace nimbus {
@@ -69,23 +71,12 @@ struct PhaseDesc {
   double g = 0;
 };
 
-struct DensityDesc {
-  enum class Type { Constant, Field, Cloud };
-  Type type = Type::Constant;
-  double scale = 1;
-  // Cloud (docs/media.md): noise octaves and base frequency, erosion depth in [0, 1), seed, and
-  // the F over which the profile rises from 0 to 1.
-  int octaves = 5;
-  double frequency = 2, amplitude = 0.6;
-  uint64_t seed = 0;
-  double edge = 1;
-};
-
 struct MediumDesc {
   std::string name;
   SpectralParam sigma_a, sigma_s, emission;
   PhaseDesc phase;
-  DensityDesc density;
+  DensityPtr density = make_constant_density();  // made by its type's reader (density_types.h)
+  double density_scale = 1;
 };
 
 struct SurfaceDesc {
