@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "nimbus/render/renderer.h"
+#include "nimbus/render/setting_names.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
 
@@ -65,7 +66,7 @@ int main(int argc, char** argv) {
       SceneDesc sized = desc;
       sized.film.height = std::max(1, desc.film.height * width / desc.film.width);
       sized.film.width = width;
-      tracking = desc.integrator.tracking;
+      tracking = name_of(kTrackingModeNames, desc.integrator.tracking.mode);
       const Scene scene = compile_scene(sized);
       const RenderResult r = render(scene, RenderOptions{1, {}, {}, {}});
       const double samples = double(scene.settings.width) * scene.settings.height * spp;

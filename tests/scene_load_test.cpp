@@ -383,7 +383,7 @@ TEST(SceneLoad, ExampleLoads) {
   EXPECT_EQ(s.camera.from, (Vec3{0, 1, 6}));
   EXPECT_EQ(s.camera.fov, 35);
   EXPECT_EQ(s.integrator.spp, 64);
-  EXPECT_EQ(s.integrator.tracking, "spectral-mis");
+  EXPECT_EQ(s.integrator.tracking.mode, TrackingSettings::Mode::SpectralMis);
 
   ASSERT_EQ(s.lights.size(), 4u);
   EXPECT_EQ(s.lights[0].type, LightDesc::Type::Environment);
@@ -439,7 +439,7 @@ TEST(SceneLoad, SpectralModeAndSpectralColours) {
                {"type": "point", "position": [0, 1, 0], "intensity": [1, 0.5, 0.25]}],
     "media": {"jade": {"sigma_s": {"spectrum": [[400, 1], [550, 4], [700, 2]]},
                        "sigma_a": 0.1}})"));
-  EXPECT_EQ(s.spectrum.mode, "spectral");
+  EXPECT_EQ(s.spectrum.mode, SpectralSettings::Mode::Spectral);
   EXPECT_EQ(s.spectrum.wavelengths, 12);
   // A blackbody keeps its curve; rgb mode gets its projection, of luminance `scale`.
   ASSERT_TRUE(s.lights[0].radiance.curve.has_value());
@@ -456,7 +456,7 @@ TEST(SceneLoad, SpectralModeAndSpectralColours) {
   EXPECT_GT(sigma_s.rgb[1], sigma_s.rgb[0]);
   EXPECT_GT(sigma_s.rgb[1], sigma_s.rgb[2]);
   for (int c = 0; c < 3; ++c) EXPECT_TRUE(sigma_s.rgb[c] >= 0.5 && sigma_s.rgb[c] <= 4.5) << c;
-  EXPECT_EQ(load(with_camera("")).spectrum.mode, "rgb");
+  EXPECT_EQ(load(with_camera("")).spectrum.mode, SpectralSettings::Mode::Rgb);
 }
 
 TEST(SceneLoad, NamedShapesAreBuiltOnceAndShared) {
@@ -494,13 +494,13 @@ TEST(SceneLoad, DefaultsApplyWhereKeysAreOptional) {
   EXPECT_EQ(s.integrator.spp, 16);
   EXPECT_EQ(s.integrator.seed, 0u);
   EXPECT_EQ(s.integrator.max_depth, 1000);
-  EXPECT_EQ(s.integrator.absorption, "weight");
-  EXPECT_FALSE(s.integrator.decomposition);
-  EXPECT_EQ(s.integrator.transmittance, "ratio");
-  EXPECT_EQ(s.integrator.majorant.source, "bound");
-  EXPECT_EQ(s.integrator.majorant.samples, 4096);
-  EXPECT_EQ(s.integrator.majorant.scale, 1.0);
-  EXPECT_EQ(s.integrator.octree.depth, 4);
+  EXPECT_EQ(s.integrator.tracking.absorption, TrackingSettings::Absorption::Weight);
+  EXPECT_FALSE(s.integrator.tracking.decomposition);
+  EXPECT_EQ(s.integrator.tracking.transmittance, TrackingSettings::Transmittance::Ratio);
+  EXPECT_EQ(s.integrator.tracking.majorant_source, TrackingSettings::MajorantSource::Bound);
+  EXPECT_EQ(s.integrator.tracking.majorant_samples, 4096);
+  EXPECT_EQ(s.integrator.tracking.majorant_scale, 1.0);
+  EXPECT_EQ(s.integrator.tracking.octree_depth, 4);
   EXPECT_TRUE(s.lights.empty());
   ASSERT_EQ(s.media.size(), 1u);
   EXPECT_TRUE(s.media[0].sigma_s.rgb.is_black());
@@ -582,16 +582,16 @@ TEST(SceneLoad, OverridesReplaceAndCreateValues) {
   EXPECT_EQ(s.integrator.spp, 256);
   EXPECT_EQ(s.camera.from, (Vec3{1, 2, 3}));
   EXPECT_EQ(s.camera.type, CameraDesc::Type::Orthographic);
-  EXPECT_EQ(s.integrator.majorant.scale, 1.5);
+  EXPECT_EQ(s.integrator.tracking.majorant_scale, 1.5);
   EXPECT_EQ(s.film.width, 200);  // the last override wins
   EXPECT_EQ(s.lights[0].radiance.rgb, Rgb({0.1, 0.2, 0.3}));
-  EXPECT_EQ(s.integrator.tracking, "spectral-mis");
-  EXPECT_EQ(s.integrator.octree.depth, 3);
+  EXPECT_EQ(s.integrator.tracking.mode, TrackingSettings::Mode::SpectralMis);
+  EXPECT_EQ(s.integrator.tracking.octree_depth, 3);
 }
 
 TEST(SceneLoad, OverrideCreatesMissingSections) {
   const SceneDesc s = load(with_camera(""), {"integrator.majorant.source=sample"});
-  EXPECT_EQ(s.integrator.majorant.source, "sample");
+  EXPECT_EQ(s.integrator.tracking.majorant_source, TrackingSettings::MajorantSource::Sample);
 }
 
 TEST(SceneLoad, OverrideReturnsTheEscapedPointer) {

@@ -18,19 +18,21 @@
 namespace nimbus {
 
 // How free paths and transmittance are estimated in media (docs/scene-format.md, integrator).
+// The defaults are those of scene files and of scenes built in code alike (docs/scene-format.md;
+// names in setting_names.h).
 struct TrackingSettings {
   enum class Mode { Delta, SpectralMax, SpectralHistory, SpectralMis };
   enum class Absorption { Collide, Weight };
   enum class Transmittance { Ratio, ResidualRatio };
   enum class MajorantSource { Bound, Sample };
-  Mode mode = Mode::Delta;  // scenes built in code; scene files default to spectral-mis
+  Mode mode = Mode::SpectralMis;
   Absorption absorption = Absorption::Weight;
   bool decomposition = false;
   Transmittance transmittance = Transmittance::Ratio;
   MajorantSource majorant_source = MajorantSource::Bound;
-  int majorant_samples = 4096;
+  int majorant_samples = 4096;  // points per octree leaf for source "sample"
   double majorant_scale = 1;  // multiplies every majorant; < 1 studies majorants that do not bound
-  int octree_depth = 0;
+  int octree_depth = 4;       // 0: one global node (the baseline)
 };
 
 // rgb: three fixed channels. spectral: `wavelengths` channels sampled per path (docs/spectra.md).

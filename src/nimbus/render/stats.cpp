@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "nimbus/render/setting_names.h"
+
 namespace nimbus {
 
 nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
@@ -17,8 +19,15 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
   j["seed"] = scene.settings.seed;
   j["threads"] = result.threads;
   const bool spectral = scene.settings.spectral.mode == SpectralSettings::Mode::Spectral;
-  j["spectrum"] = {{"mode", spectral ? "spectral" : "rgb"},
+  j["spectrum"] = {{"mode", name_of(kSpectrumModeNames, scene.settings.spectral.mode)},
                    {"channels", spectral ? scene.settings.spectral.wavelengths : 3}};
+  const TrackingSettings& t = scene.settings.tracking;
+  j["tracking"] = {{"mode", name_of(kTrackingModeNames, t.mode)},
+                   {"absorption", name_of(kAbsorptionNames, t.absorption)},
+                   {"decomposition", t.decomposition},
+                   {"transmittance", name_of(kTransmittanceNames, t.transmittance)},
+                   {"majorant_source", name_of(kMajorantSourceNames, t.majorant_source)},
+                   {"majorant_scale", t.majorant_scale}};
   j["wall_seconds"] = result.seconds;
   j["samples_per_second"] = result.seconds > 0 ? samples / result.seconds : 0.0;
   j["image_mean"] = {m.mean[0], m.mean[1], m.mean[2]};

@@ -64,25 +64,6 @@ Surface compile_surface(const SurfaceDesc& d) {
   return s;
 }
 
-TrackingSettings compile_tracking(const IntegratorDesc& d) {
-  using T = TrackingSettings;
-  T t;
-  t.mode = d.tracking == "spectral-max"       ? T::Mode::SpectralMax
-           : d.tracking == "spectral-history" ? T::Mode::SpectralHistory
-           : d.tracking == "spectral-mis"     ? T::Mode::SpectralMis
-                                              : T::Mode::Delta;
-  t.absorption = d.absorption == "collide" ? T::Absorption::Collide : T::Absorption::Weight;
-  t.decomposition = d.decomposition;
-  t.transmittance = d.transmittance == "residual-ratio" ? T::Transmittance::ResidualRatio
-                                                        : T::Transmittance::Ratio;
-  t.majorant_source =
-      d.majorant.source == "sample" ? T::MajorantSource::Sample : T::MajorantSource::Bound;
-  t.majorant_samples = d.majorant.samples;
-  t.majorant_scale = d.majorant.scale;
-  t.octree_depth = d.octree.depth;
-  return t;
-}
-
 Medium compile_medium(const MediumDesc& d) {
   Medium m;
   m.sigma_a = d.sigma_a;
@@ -103,10 +84,8 @@ Scene compile_scene(const SceneDesc& desc) {
   scene.settings.spp = desc.integrator.spp;
   scene.settings.seed = desc.integrator.seed;
   scene.settings.max_depth = desc.integrator.max_depth;
-  scene.settings.tracking = compile_tracking(desc.integrator);
-  scene.settings.spectral.mode = desc.spectrum.mode == "spectral" ? SpectralSettings::Mode::Spectral
-                                                                  : SpectralSettings::Mode::Rgb;
-  scene.settings.spectral.wavelengths = desc.spectrum.wavelengths;
+  scene.settings.tracking = desc.integrator.tracking;
+  scene.settings.spectral = desc.spectrum;
   scene.camera = compile_camera(desc.camera, desc.film);
 
   for (const MediumDesc& md : desc.media) scene.media.push_back(compile_medium(md));

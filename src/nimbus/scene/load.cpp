@@ -13,6 +13,7 @@
 #include "nimbus/frep/primitives.h"
 #include "nimbus/media/octree.h"
 #include "nimbus/render/scene.h"
+#include "nimbus/render/setting_names.h"
 #include "nimbus/scene/density_types.h"
 
 namespace nimbus {
@@ -63,6 +64,15 @@ SpectralParam read_colour(const JsonValue& v, SpectralRole role, const Range& ra
 std::string string_choice(const JsonValue& v, std::string_view noun,
                           const std::vector<std::string_view>& names) {
   return std::string(names[v.choice(noun, names)]);
+}
+
+// One of a setting's names (render/setting_names.h), as its value.
+template <class E, size_t K>
+E choice_of(const JsonValue& v, std::string_view noun,
+            const std::array<std::pair<std::string_view, E>, K>& table) {
+  std::vector<std::string_view> names;
+  for (const auto& entry : table) names.push_back(entry.first);
+  return table[v.choice(noun, names)].second;
 }
 
 Mat4 read_transform(const JsonValue& v) {
@@ -182,8 +192,7 @@ class Loader {
   static SpectrumDesc read_spectrum(const JsonValue& v) {
     JsonObject o(v);
     SpectrumDesc d;
-    if (auto x = o.optional("mode"))
-      d.mode = string_choice(*x, "spectrum mode", {"rgb", "spectral"});
+    if (auto x = o.optional("mode")) d.mode = choice_of(*x, "spectrum mode", kSpectrumModeNames);
     if (auto x = o.optional("wavelengths"))
       d.wavelengths = x->integer(between(kMinWavelengths, kMaxWavelengths));
     o.finish();
@@ -196,26 +205,25 @@ class Loader {
     if (auto x = o.optional("spp")) d.spp = x->integer(at_least(1));
     if (auto x = o.optional("seed")) d.seed = x->unsigned_integer();
     if (auto x = o.optional("max_depth")) d.max_depth = x->integer(at_least(1));
-    if (auto x = o.optional("tracking"))
-      d.tracking = string_choice(*x, "tracking",
-                                 {"delta", "spectral-max", "spectral-history", "spectral-mis"});
+    TrackingSettings& t = d.tracking;
+    if (auto x = o.optional("tracking")) t.mode = choice_of(*x, "tracking", kTrackingModeNames);
     if (auto x = o.optional("absorption"))
-      d.absorption = string_choice(*x, "absorption", {"weight", "collide"});
-    if (auto x = o.optional("decomposition")) d.decomposition = x->boolean();
+      t.absorption = choice_of(*x, "absorption", kAbsorptionNames);
+    if (auto x = o.optional("decomposition")) t.decomposition = x->boolean();
     if (auto x = o.optional("transmittance"))
-      d.transmittance = string_choice(*x, "transmittance", {"ratio", "residual-ratio"});
+      t.transmittance = choice_of(*x, "transmittance", kTransmittanceNames);
     if (auto x = o.optional("majorant")) {
       JsonObject m(*x);
       if (auto y = m.optional("source"))
-        d.majorant.source = string_choice(*y, "majorant source", {"bound", "sample"});
-      if (auto y = m.optional("samples")) d.majorant.samples = y->integer(at_least(1));
-      if (auto y = m.optional("scale")) d.majorant.scale = y->number(above(0));
+        t.majorant_source = choice_of(*y, "majorant source", kMajorantSourceNames);
+      if (auto y = m.optional("samples")) t.majorant_samples = y->integer(at_least(1));
+      if (auto y = m.optional("scale")) t.majorant_scale = y->number(above(0));
       m.finish();
     }
     if (auto x = o.optional("octree")) {
-      JsonObject t(*x);
-      if (auto y = t.optional("depth")) d.octree.depth = y->integer(between(0, kOctreeMaxDepth));
-      t.finish();
+      JsonObject oc(*x);
+      if (auto y = oc.optional("depth")) t.octree_depth = y->integer(between(0, kOctreeMaxDepth));
+      oc.finish();
     }
     o.finish();
     return d;

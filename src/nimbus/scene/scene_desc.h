@@ -11,6 +11,7 @@
 #include "nimbus/math/vec3.h"
 #include "nimbus/media/constant_density.h"
 #include "nimbus/media/density.h"
+#include "nimbus/render/scene.h"
 #include "nimbus/spectral/spectral_param.h"
 
 namespace nimbus {
@@ -31,25 +32,11 @@ struct IntegratorDesc {
   int spp = 16;
   uint64_t seed = 0;
   int max_depth = 1000;
-  std::string tracking = "spectral-mis";  // delta | spectral-max | spectral-history | spectral-mis
-  std::string absorption = "weight";      // weight | collide
-  bool decomposition = false;
-  std::string transmittance = "ratio";  // ratio | residual-ratio
-  struct Majorant {
-    std::string source = "bound";  // bound | sample
-    int samples = 4096;            // points per octree node for source "sample"
-    double scale = 1.0;            // safety factor applied to every majorant
-  } majorant;
-  struct Octree {
-    int depth = 4;  // 0: one global node (the baseline)
-  } octree;
+  TrackingSettings tracking;  // its defaults are the scene format's
 };
 
 // How colours are carried (docs/spectra.md): "rgb" or "spectral" with `wavelengths` per path.
-struct SpectrumDesc {
-  std::string mode = "rgb";  // rgb | spectral
-  int wavelengths = 8;       // spectral: 4..16
-};
+using SpectrumDesc = SpectralSettings;
 
 // Colour inputs are SpectralParam: RGB (a number or [r, g, b]) or a curve from the file
 // ({"spectrum": [[nm, value], ...]}, or {"blackbody": K, "scale": s} where light is emitted).
