@@ -118,10 +118,22 @@ int run_render(const RenderArgs& args) {
   return 0;
 }
 
+// nimbus's data (scenes/, tools/plot_*.py): share/nimbus beside the executable (the build tree
+// links it there) or above it (an installed prefix: bin/nimbus, share/nimbus).
+std::filesystem::path data_dir() {
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) return "share/nimbus";
+  for (const std::filesystem::path& d : {exe.parent_path() / "share" / "nimbus",
+                                         exe.parent_path().parent_path() / "share" / "nimbus"})
+    if (std::filesystem::exists(d / "scenes")) return d;
+  return exe.parent_path().parent_path() / "share" / "nimbus";
+}
+
 struct ExperimentArgs {
   std::string name;
   std::string out;
-  std::string scenes = std::string(NIMBUS_SOURCE_DIR) + "/scenes";
+  std::string scenes = (data_dir() / "scenes").string();
   bool quick = false;
   bool no_plot = false;
   long long seed = 0;
@@ -136,8 +148,7 @@ constexpr const char* kPlotPython = "/usr/bin/python3";
 void plot(const std::string& name, const std::filesystem::path& out) {
   std::string stem = name;
   std::replace(stem.begin(), stem.end(), '-', '_');
-  const std::filesystem::path script =
-      std::filesystem::path(NIMBUS_SOURCE_DIR) / "tools" / ("plot_" + stem + ".py");
+  const std::filesystem::path script = data_dir() / "tools" / ("plot_" + stem + ".py");
   if (!std::filesystem::exists(script)) return;
   const std::string probe = fmt::format("{} -c 'import matplotlib' >/dev/null 2>&1", kPlotPython);
   if (std::system(probe.c_str()) != 0) {

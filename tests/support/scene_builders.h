@@ -9,6 +9,7 @@
 #include "nimbus/math/constants.h"
 #include "nimbus/media/octree.h"
 #include "nimbus/render/scene.h"
+#include "nimbus/scene/compile.h"
 
 namespace nimbus::test {
 
@@ -47,11 +48,7 @@ inline TrackingSettings tracking_settings(TrackingSettings::Mode mode,
 
 // Field objects, spectra and majorant octrees, as compile_scene derives them.
 inline void finish_media(Scene& scene) {
-  for (size_t i = 0; i < scene.objects.size(); ++i)
-    if (scene.objects[i].surface.type == Surface::Type::None && scene.objects[i].medium >= 0)
-      scene.field_objects.push_back(static_cast<int>(i));
-  complete_spectra(scene);
-  build_majorant_octrees(scene);
+  finish_scene(scene);
 }
 
 // Chandrasekhar's half-space: `medium` filling a sphere of radius 1000 seen near its top by a

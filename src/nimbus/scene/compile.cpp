@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <stdexcept>
+
 #include "nimbus/frep/bounds.h"
 #include "nimbus/media/medium_field.h"
 #include "nimbus/media/octree.h"
@@ -90,7 +92,7 @@ Scene compile_scene(const SceneDesc& desc) {
 
   for (const MediumDesc& md : desc.media) scene.media.push_back(compile_medium(md));
 
-  Box all;
+  int field_objects = 0;  // finish_scene lists them; here they are counted for the message
   for (const ObjectDesc& od : desc.objects) {
     SceneObject obj;
     obj.tape = compile(*od.shape);
@@ -107,22 +109,36 @@ Scene compile_scene(const SceneDesc& desc) {
         obj.surface.type == Surface::Type::Diffuse || obj.surface.type == Surface::Type::Emissive
             ? -1
             : od.medium;
-    if (obj.surface.type == Surface::Type::None) {
-      if (scene.field_objects.size() == kMaxMediaAtPoint)
+    if (obj.surface.type == Surface::Type::None && obj.medium >= 0) {
+      if (++field_objects > kMaxMediaAtPoint)
         throw SceneError(
             fmt::format("{}: {}/medium: at most {} index-matched (surface none) "
                         "medium objects are supported",
                         desc.source, od.json_path, kMaxMediaAtPoint));
-      scene.field_objects.push_back(static_cast<int>(scene.objects.size()));
     }
-    all = unite(all, obj.bounds);
     scene.objects.push_back(std::move(obj));
   }
   for (const LightDesc& ld : desc.lights) scene.lights.push_back(compile_light(ld));
+  finish_scene(scene);
+  return scene;
+}
+
+void finish_scene(Scene& scene) {
+  scene.field_objects.clear();
+  Box all;
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const SceneObject& obj = scene.objects[i];
+    all = unite(all, obj.bounds);
+    if (obj.surface.type == Surface::Type::None && obj.medium >= 0)
+      scene.field_objects.push_back(static_cast<int>(i));
+  }
+  if (scene.field_objects.size() > size_t(kMaxMediaAtPoint))
+    throw std::invalid_argument(
+        fmt::format("{} index-matched medium objects; at most {} are supported",
+                    scene.field_objects.size(), kMaxMediaAtPoint));
   if (!all.empty()) scene.scale = length(all.extent());
   complete_spectra(scene);
   build_majorant_octrees(scene);
-  return scene;
 }
 
 }  // namespace nimbus

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# The library as a user gets it (ctest InstallAndEmbed): installs the build tree BUILD into a
+# temporary prefix, copies EXAMPLE (examples/embed) out of the source tree, configures it with
+# find_package(nimbus) from that prefix alone, builds it, runs it, and checks its image. The
+# installed nimbus executable must find its scenes without the checkout, and pkg-config must
+# describe the library.
+#
+# Usage: tools/test_install.sh BUILD EXAMPLE
+set -euo pipefail
+build=$1
+example=$2
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+prefix="$work/prefix"
+
+cmake --install "$build" --prefix "$prefix" > "$work/install.log"
+for f in lib/libnimbus_core.a lib/cmake/nimbus/nimbusConfig.cmake \
+         lib/cmake/nimbus/nimbusConfigVersion.cmake lib/pkgconfig/nimbus.pc \
+         include/nimbus/nimbus.h bin/nimbus share/nimbus/scenes/demo.json \
+         share/nimbus/tools/plot_segments.py; do
+  [ -e "$prefix/$f" ] || { echo "test_install: $f was not installed" >&2; exit 1; }
+done
+
+cp -r "$example" "$work/embed"
+cmake -S "$work/embed" -B "$work/embed-build" -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_PREFIX_PATH="$prefix" > "$work/configure.log" ||
+  { cat "$work/configure.log" >&2; exit 1; }
+cmake --build "$work/embed-build" -j"$(nproc)" > "$work/build.log" ||
+  { cat "$work/build.log" >&2; exit 1; }
+"$work/embed-build/embed" "$work/out.png"
+[ -s "$work/out.png" ] || { echo "test_install: the example wrote no image" >&2; exit 1; }
+head -c 8 "$work/out.png" | od -An -c | grep -q "P   N   G" ||
+  { echo "test_install: the example's image is not a PNG" >&2; exit 1; }
+
+# pkg-config knows the library and where its headers are.
+PKG_CONFIG_PATH="$prefix/lib/pkgconfig" pkg-config --cflags --libs nimbus | grep -q -- "-lnimbus_core" ||
+  { echo "test_install: pkg-config does not describe nimbus" >&2; exit 1; }
+
+# The installed executable runs an experiment from the installed scenes, away from the checkout.
+(cd "$work" && "$prefix/bin/nimbus" experiment segments --quick --no-plot --out "$work/exp" > /dev/null)
+[ -s "$work/exp/segments.csv" ] || { echo "test_install: the installed nimbus ran no experiment" >&2; exit 1; }
+echo "test_install: installed, built examples/embed outside the tree, rendered, ran an experiment"
