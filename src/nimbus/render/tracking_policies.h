@@ -1,0 +1,162 @@
+#pragma once
+// The tracking modes as policies of the one path loop (render/integrator.h). A policy owns the
+// path's per-path state and answers what differs between the modes: the next real collision
+// along a ray, the weight of a light found by next-event estimation (its shadow ray's
+// transmittance and MIS), the weight of a light or an emitter the path hits, the update of its
+// throughput at a scattering vertex, and Russian roulette. Everything else (surfaces, lights,
+// phase sampling, the order of random numbers) is the loop's, once.
+//
+// - PlainTracking: delta tracking, spectral-max and spectral-history (one throughput beta;
+//   power-heuristic MIS between light sampling and BSDF or phase sampling).
+// - HeroTracking: null-scattering spectral MIS (Miller et al. 2019): a hero channel per path,
+//   path pdfs r_u and r_l, the balance heuristic over channels and techniques.
+//
+// Adding a tracking mode: a policy with these members (docs/architecture.md), a name in
+// render/setting_names.h, and its dispatch in radiance().
+
+#include <algorithm>
+
+#include "nimbus/math/rng.h"
+#include "nimbus/render/counters.h"
+#include "nimbus/render/light.h"
+#include "nimbus/render/path_spectra.h"
+#include "nimbus/render/sampling.h"
+#include "nimbus/render/scene.h"
+#include "nimbus/render/volume.h"
+#include "nimbus/spectral/spectrum.h"
+
+namespace nimbus {
+
+// Largest magnitude over channels: spectral tracking with a majorant that does not bound can
+// make weights negative.
+template <int N>
+double max_abs(const Spectrum<N>& x) {
+  double m = 0;
+  for (int c = 0; c < N; ++c) m = std::max(m, std::abs(x[c]));
+  return m;
+}
+
+// Continues the path with probability q = min(1, max|beta / scale|) from depth 3 on.
+template <int N>
+bool russian_roulette(Spectrum<N>& beta, double scale, int depth, Rng& rng) {
+  if (depth < 3) return true;
+  const double q = std::min(1.0, max_abs(beta) / scale);
+  if (q <= 0 || rng.uniform() >= q) return false;
+  beta /= q;  // unbiased: survivors carry 1/q
+  return true;
+}
+
+template <int N>
+class PlainTracking {
+ public:
+  explicit PlainTracking(Rng&) {}
+
+  // The path throughput, which multiplies next-event estimates.
+  const Spectrum<N>& throughput() const { return beta_; }
+
+  MediumEvent<N> collide(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray, double t_max,
+                         int inside, Rng& rng, Counters& counters) {
+    return sample_collision(scene, ps, ray, t_max, inside, beta_, channel_, rng, counters);
+  }
+
+  // Next-event estimation of one light sample `ls` along `shadow` (to t_max): fLi is the
+  // scattering function times the light's incident radiance; f_pdf the scattering pdf of the
+  // direction. False where the light is blocked.
+  template <class Pdf>
+  bool light_term(const Scene& scene, const PathSpectra<N>& ps, const Ray& shadow, double t_max,
+                  int light, int inside, const LightSample& ls, const Spectrum<N>& fLi, Pdf&& f_pdf,
+                  Rng& rng, Counters& counters, Spectrum<N>& out) const {
+    const Spectrum<N> T =
+        transmittance(scene, ps, shadow, t_max, light, inside, channel_, rng, counters);
+    if (T.is_black()) return false;
+    out = ls.delta ? fLi * T : fLi * T * (power_heuristic(ls.pdf, f_pdf(ls.wi)) / ls.pdf);
+    return true;
+  }
+
+  // Radiance Le of `light` reached along dir from prev_p; `light_sampled`: the vertex there
+  // sampled the lights too.
+  Spectrum<N> light_hit(const Spectrum<N>& Le, const Light& light, const Vec3& prev_p,
+                        const Vec3& dir, bool light_sampled) const {
+    return beta_ * Le *
+           (light_sampled ? power_heuristic(prev_pdf_, light_pdf(light, prev_p, dir)) : 1.0);
+  }
+
+  // Radiance of an emissive surface the path hits (never light-sampled).
+  Spectrum<N> emission(const Spectrum<N>& Le) const { return beta_ * Le; }
+
+  // A scattering vertex: the throughput times weight (f cos / pdf), the direction drawn with pdf.
+  void scattered(const Spectrum<N>& weight, double pdf) {
+    beta_ *= weight;
+    prev_pdf_ = pdf;
+  }
+
+  bool roulette(int depth, Rng& rng) { return russian_roulette(beta_, 1.0, depth, rng); }
+
+ private:
+  Spectrum<N> beta_{1.0};
+  // Delta tracking follows one channel per path, chosen uniformly when the path first meets a
+  // medium (sample_collision), and from then on carries its weight (times N) in that channel.
+  int channel_ = -1;
+  double prev_pdf_ = 0;  // solid-angle pdf with which the current direction was sampled
+};
+
+template <int N>
+class HeroTracking {
+ public:
+  explicit HeroTracking(Rng& rng) : hero_(std::min(N - 1, static_cast<int>(rng.uniform() * N))) {}
+
+  const Spectrum<N>& throughput() const { return path_.beta; }
+
+  MediumEvent<N> collide(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray, double t_max,
+                         int inside, Rng& rng, Counters& counters) {
+    return sample_collision_mis(scene, ps, ray, t_max, inside, hero_, path_, rng, counters);
+  }
+
+  // Miller et al. 2019, §6 (pbrt-v4's SampleLd): the shadow ray's T_ray, r_u and r_l from hero
+  // ratio tracking, the vertex pdfs folded in with the path's r_u, and the balance heuristic over
+  // channels and both techniques:
+  //   f Li T_ray / avg(r_u (p_light r_l + p_f r_u)),  or f Li T_ray / avg(r_u r_l) for delta
+  //   lights.
+  template <class Pdf>
+  bool light_term(const Scene& scene, const PathSpectra<N>& ps, const Ray& shadow, double t_max,
+                  int light, int inside, const LightSample& ls, const Spectrum<N>& fLi, Pdf&& f_pdf,
+                  Rng& rng, Counters& counters, Spectrum<N>& out) const {
+    MisPath<N> s;
+    if (!transmittance_mis(scene, ps, shadow, t_max, light, inside, hero_, s, rng, counters))
+      return false;
+    const Spectrum<N>& r_p = path_.r_u;
+    if (ls.delta) {
+      out = fLi * s.beta / (r_p * s.r_l).average();
+    } else {
+      const Spectrum<N> r_l = r_p * s.r_l * ls.pdf, r_u = r_p * s.r_u * f_pdf(ls.wi);
+      out = fLi * s.beta / (r_l + r_u).average();
+    }
+    return true;
+  }
+
+  Spectrum<N> light_hit(const Spectrum<N>& Le, const Light& light, const Vec3& prev_p,
+                        const Vec3& dir, bool light_sampled) const {
+    if (!light_sampled) return path_.beta * Le / path_.r_u.average();
+    const Spectrum<N> r_l = path_.r_l * light_pdf(light, prev_p, dir);
+    return path_.beta * Le / (path_.r_u + r_l).average();
+  }
+
+  Spectrum<N> emission(const Spectrum<N>& Le) const {
+    return path_.beta * Le / path_.r_u.average();
+  }
+
+  void scattered(const Spectrum<N>& weight, double pdf) {
+    path_.beta *= weight;
+    path_.r_l = path_.r_u / pdf;
+  }
+
+  bool roulette(int depth, Rng& rng) {
+    return russian_roulette(path_.beta, path_.r_u.average(), depth, rng);
+  }
+
+ private:
+  int hero_;
+  MisPath<N> path_;
+};
+
+}  // namespace nimbus
