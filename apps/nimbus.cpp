@@ -15,6 +15,7 @@
 
 #include "nimbus/experiments/experiment.h"
 #include "nimbus/io/atomic_file.h"
+#include "nimbus/io/film_image.h"
 #include "nimbus/io/output.h"
 #include "nimbus/render/renderer.h"
 #include "nimbus/render/stats.h"

@@ -13,6 +13,7 @@
 #include "nimbus/frep/primitives.h"
 #include "nimbus/frep/tape.h"
 #include "nimbus/io/film_file.h"
+#include "nimbus/io/film_image.h"
 #include "nimbus/io/output.h"
 #include "nimbus/media/cloud_density.h"
 #include "nimbus/media/constant_density.h"

@@ -4,6 +4,7 @@
 
 #include <array>
 
+#include "nimbus/io/film_image.h"
 #include "nimbus/io/output.h"
 #include "nimbus/render/renderer.h"
 #include "nimbus/scene/compile.h"

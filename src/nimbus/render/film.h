@@ -12,7 +12,6 @@
 #include <cstdint>
 #include <vector>
 
-#include "nimbus/io/image.h"
 #include "nimbus/spectral/spectrum.h"
 
 namespace nimbus {
@@ -42,8 +41,6 @@ struct Film {
 // Adds `from` into `into` (films of one size, else std::invalid_argument): a pixel `into` has no
 // samples of takes `from`'s sums as they are; otherwise the sums and counts are added.
 void merge(Film& into, const Film& from);
-
-Image to_image(const Film& film);
 
 // The average of a set of pixel means and its standard error (pixels are independent).
 struct MeanEstimate {
