@@ -512,6 +512,36 @@ TEST(MediaRenderLights, LightInsideASolidMatchesTheSameLightInAField) {
   }
 }
 
+// Issue 16: an HG g of ±0.99999999 or 0.9999999999999999 is accepted and wrote NaN pixels in
+// every mode; now every pixel is finite, in rgb and in spectral mode.
+TEST(MediaRenderPhase, ExtremeAsymmetryRendersFinitePixels) {
+  using M = TrackingSettings::Mode;
+  for (double g : {0.99999999, -0.99999999, 0.9999999999999999})
+    for (M mode : {M::Delta, M::SpectralMax, M::SpectralHistory, M::SpectralMis})
+      for (bool spectral : {false, true}) {
+        Medium m = chromatic_scatterer();
+        m.g = g;
+        Scene scene = furnace_scene(
+            m, Surface::Type::None, unit_sphere(),
+            test::tracking_settings(mode, TrackingSettings::Absorption::Weight, false, 4), 8);
+        if (spectral) scene.settings.spectral = {SpectralSettings::Mode::Spectral, 4};
+        scene.lights.push_back(test::environment(0.5));
+        Light sun;
+        sun.type = Light::Type::Directional;
+        sun.direction = normalize(Vec3{-0.3, -1, 0.2});
+        sun.emission = Rgb(2.0);
+        scene.lights.push_back(sun);
+        test::finish_media(scene);
+        const RenderResult r = render(scene);
+        for (int p = 0; p < r.film.pixels(); ++p)
+          for (int c = 0; c < 3; ++c)
+            ASSERT_TRUE(std::isfinite(r.film.sum[p][c]) && std::isfinite(r.film.sum_sq[p][c]))
+                << r.film.sum[p][c] << " " << r.film.sum_sq[p][c] << " "
+                << "g " << g << ", mode " << int(mode) << (spectral ? ", spectral" : "")
+                << ", pixel " << p;
+      }
+}
+
 INSTANTIATE_TEST_SUITE_P(Modes, MediaRender, testing::ValuesIn(mode_cases()), mode_name);
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -55,6 +56,31 @@ TEST(Phase, CosineInversionIsStableAndMonotone) {
   }
   for (double u : {0.1, 0.37, 0.5, 0.9})
     EXPECT_NEAR(sample_hg_cos_theta(1e-10, u), 2 * u - 1, 1e-9);
+}
+
+// Issue 16: g = ±0.99999999 and ±0.9999999999999999 passed validation and wrote NaN pixels:
+// 1 + g² − 2 g cos θ cancelled to 0 or below at cos θ = ±1. Over the whole accepted range
+// (−1, 1) the density is finite and positive, matches (1 − g²)/(4π (1 − g)³) exactly at its peak,
+// and the sampler returns cosines in [−1, 1] whose density is finite.
+TEST(Phase, StableAtTheEndsOfTheAcceptedRange) {
+  for (double g : {0.99999999, 0.9999999999999999, 1 - 1e-12, -0.99999999, -0.9999999999999999}) {
+    const double peak = g > 0 ? 1.0 : -1.0;
+    const double expected = kInv4Pi * (1 + std::abs(g)) / std::pow(1 - std::abs(g), 2);
+    EXPECT_NEAR(hg_phase(peak, g) / expected, 1, 1e-12) << g;
+    for (double c : {-1.0, -0.999999, -0.5, 0.0, 0.5, 0.999999, 1.0}) {
+      const double p = hg_phase(c, g);
+      EXPECT_TRUE(std::isfinite(p) && p > 0) << "g " << g << ", cos " << c << ": " << p;
+    }
+    Rng rng(21);
+    for (int i = 0; i < 10000; ++i) {
+      const double u =
+          i < 3 ? std::array<double, 3>{0.0, 1e-300, std::nextafter(1.0, 0.0)}[i] : rng.uniform();
+      const double c = sample_hg_cos_theta(g, u);
+      ASSERT_TRUE(c >= -1 && c <= 1) << "g " << g << ", u " << u << ": " << c;
+      const double p = hg_phase(c, g);
+      ASSERT_TRUE(std::isfinite(p) && p > 0) << "g " << g << ", u " << u;
+    }
+  }
 }
 
 TEST(Phase, SampledDirectionsAreUnit) {

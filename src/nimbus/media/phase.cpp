@@ -7,8 +7,14 @@
 namespace nimbus {
 
 double hg_phase(double cos_theta, double g) {
-  const double denom = 1 + g * g - 2 * g * cos_theta;
-  return kInv4Pi * (1 - g * g) / (denom * std::sqrt(denom));
+  // 1 + g² − 2 g cos θ, written as a sum of non-negative terms: as |g| → 1 the plain form
+  // cancels to 0 or below at cos θ = ±1 (NaN and Inf pixels, issue 16), this one stays exact to
+  // rounding: (1 − g)² + 2 g (1 − cos θ) for g >= 0, (1 + g)² − 2 g (1 + cos θ) for g < 0.
+  // The cosine of two unit vectors can round past ±1, which would make the second term negative.
+  const double c = std::clamp(cos_theta, -1.0, 1.0);
+  const double denom =
+      g >= 0 ? (1 - g) * (1 - g) + 2 * g * (1 - c) : (1 + g) * (1 + g) - 2 * g * (1 + c);
+  return kInv4Pi * ((1 - g) * (1 + g)) / (denom * std::sqrt(denom));
 }
 
 double sample_hg_cos_theta(double g, double u1) {
