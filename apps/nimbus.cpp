@@ -85,6 +85,11 @@ int run_render(const RenderArgs& args) {
     };
   const RenderResult result = render(scene, options);
   if (show_progress) std::fprintf(stderr, "\n");
+  if (const uint64_t n = result.counters.rejected_samples; n > 0)
+    std::fprintf(stderr,
+                 "nimbus: warning: %llu samples were NaN or infinite and counted as 0 "
+                 "(counters.rejected_samples in --stats)\n",
+                 static_cast<unsigned long long>(n));
 
   // All or nothing: if one output cannot be written, remove those already written.
   std::vector<std::string> written;

@@ -202,6 +202,30 @@ TEST_F(Cli, RendersDefaultOutputsAndStats) {
   EXPECT_GE(s["octree"]["depth"].get<int>(), 0);
   EXPECT_EQ(s["spectrum"]["mode"], "rgb");
   EXPECT_EQ(s["spectrum"]["channels"], 3);
+  EXPECT_EQ(s["tracking"]["mode"], "spectral-mis");
+  EXPECT_EQ(s["tracking"]["absorption"], "weight");
+  EXPECT_EQ(s["counters"]["rejected_samples"], 0);
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+}
+
+// Issue 16: a sample whose value overflows (here a sky of radiance 1e200, whose square is
+// infinite) never enters the film; it is counted, reported once, and the rest is written.
+TEST_F(Cli, OverflowingSamplesAreRejectedCountedAndReported) {
+  nlohmann::json scene = good_scene();
+  scene["lights"][0]["radiance"] = 1e200;
+  write("scene.json", scene.dump());
+  const Outcome r = run("render scene.json --stats stats.json --spp 2 -o out.exr");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream f(dir_ / "stats.json");
+  const nlohmann::json s = nlohmann::json::parse(f);
+  const long rejected = s["counters"]["rejected_samples"].get<long>();
+  EXPECT_GT(rejected, 0);
+  EXPECT_LE(rejected, 16 * 12 * 2);
+  EXPECT_NE(r.err.find("warning: " + std::to_string(rejected) +
+                       " samples were NaN or infinite and counted as 0"),
+            std::string::npos)
+      << r.err;
+  for (int c = 0; c < 3; ++c) EXPECT_TRUE(s["image_mean"][c].is_number()) << "not null: finite";
 }
 
 TEST_F(Cli, RendersInSpectralModeFromTheCommandLine) {

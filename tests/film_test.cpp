@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -149,6 +150,23 @@ TEST(Film, CancelledRendersLeaveWholePixelsOnly) {
   EXPECT_LT(done, film.pixels());
   // The rest can be rendered later: the pixels still at 0 continue from 0.
   EXPECT_FALSE(render_into(scene, film, range(20, 16, 37, 23, 0, -1)).cancelled);
+}
+
+// Issue 16: a NaN, an infinity or a value whose square overflows never enters the sums; it
+// counts as a sample of value 0. Negative values (signed weights) are samples like any other.
+TEST(Film, RefusesValuesThatWouldPoisonThePixel) {
+  Film film(2, 1);
+  EXPECT_TRUE(film.add(0, Rgb({1.0, -2.0, 3.0})));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const Rgb& bad :
+       {Rgb({nan, 0.0, 0.0}), Rgb({0.0, inf, 0.0}), Rgb({0.0, 0.0, -inf}), Rgb({1e200, 1.0, 1.0})})
+    EXPECT_FALSE(film.add(0, bad));
+  EXPECT_EQ(film.samples[0], 5u);
+  EXPECT_EQ(film.sum[0], Rgb({1.0, -2.0, 3.0}));
+  EXPECT_EQ(film.sum_sq[0], Rgb({1.0, 4.0, 9.0}));
+  EXPECT_EQ(film.mean(0), Rgb({0.2, -0.4, 0.6}));
+  EXPECT_EQ(film.samples[1], 0u);
 }
 
 TEST(Film, RoundTripsThroughAFile) {

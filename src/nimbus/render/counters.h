@@ -14,6 +14,7 @@ struct Counters {
   uint64_t real_collisions = 0;    // scattering or absorption events in media
   uint64_t scatter_events = 0;     // real scattering events in media
   uint64_t majorant_segments = 0;  // segments of the majorant walk that estimators tracked over
+  uint64_t rejected_samples = 0;   // NaN or infinite sample values the film refused (film.h)
   TrackingCounters tracking;       // tentative collisions, density lookups, clamped probabilities
 
   uint64_t null_collisions() const { return tracking.tentative_collisions - real_collisions; }
@@ -25,6 +26,7 @@ struct Counters {
     real_collisions += o.real_collisions;
     scatter_events += o.scatter_events;
     majorant_segments += o.majorant_segments;
+    rejected_samples += o.rejected_samples;
     tracking += o.tracking;
     return *this;
   }

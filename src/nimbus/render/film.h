@@ -9,6 +9,7 @@
 // film left off (render_into checks that it does). Two films holding different samples of the
 // same pixel merge by adding their sums: the same expectation, not the same bits.
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -25,10 +26,19 @@ struct Film {
   Film(int w, int h)
       : width(w), height(h), sum(size_t(w) * h), sum_sq(size_t(w) * h), samples(size_t(w) * h, 0) {}
   int pixels() const { return width * height; }
-  void add(int pixel, const Rgb& value) {
-    sum[pixel] += value;
-    sum_sq[pixel] += value * value;
+  // Adds one sample. A value that is NaN or infinite in any channel, or whose square is not
+  // finite, never enters the sums (one such sample would poison the pixel for good): it counts
+  // as a sample of value 0, so the pixel's sample count stays the number of samples rendered,
+  // and add returns false so that the caller can report it. Negative values are accepted: the
+  // weighted trackers are unbiased through signed weights where majorants do not bound.
+  bool add(int pixel, const Rgb& value) {
     ++samples[pixel];
+    const Rgb sq = value * value;
+    for (int c = 0; c < 3; ++c)
+      if (!std::isfinite(sq[c])) return false;
+    sum[pixel] += value;
+    sum_sq[pixel] += sq;
+    return true;
   }
   // The pixel's mean sample value; 0 for a pixel without samples.
   Rgb mean(int pixel) const {

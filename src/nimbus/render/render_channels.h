@@ -55,7 +55,7 @@ RenderStats render_channels(const Scene& scene, Film& film, const RenderRange& r
               const Ray ray = scene.camera.generate(x + u1, y + u2);
               if (spectral) prepare_path_spectra(ps, scene, rng.uniform());
               const Spectrum<N> L = radiance(scene, ps, ray, rng, local);
-              film.add(pixel, to_film_rgb(L, ps.ch));
+              if (!film.add(pixel, to_film_rgb(L, ps.ch))) ++local.rejected_samples;
             }
           }
         const long done = pixels_done += long(tile.rows().size()) * long(tile.cols().size());

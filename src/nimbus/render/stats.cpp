@@ -34,6 +34,7 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
   j["image_mean_standard_error"] = {m.standard_error[0], m.standard_error[1], m.standard_error[2]};
   j["counters"] = {
       {"paths", c.paths},
+      {"rejected_samples", c.rejected_samples},
       {"surface_rays", c.surface_rays},
       {"shadow_rays", c.shadow_rays},
       {"path_segments", c.tracking.tentative_collisions},
