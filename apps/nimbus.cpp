@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -215,6 +216,27 @@ int run_experiment(const ExperimentArgs& args) {
 
 }  // namespace
 
+// An integer option's check that says its range in words: "--spp must be >= 1, not 0". (CLI11's
+// own range checks print the double bounds of the option's type.)
+CLI::Validator integer_at_least(long long lo, long long hi = std::numeric_limits<int>::max()) {
+  return CLI::Validator(
+      [lo, hi](std::string& value) -> std::string {
+        long long x = 0;
+        size_t used = 0;
+        try {
+          x = std::stoll(value, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used == 0 || used != value.size())
+          return fmt::format("must be a whole number, not \"{}\"", value);
+        if (x < lo) return fmt::format("must be >= {}, not {}", lo, x);
+        if (x > hi) return fmt::format("must be <= {}, not {}", hi, x);
+        return {};
+      },
+      fmt::format("INT >= {}", lo));
+}
+
 int main(int argc, char** argv) {
   CLI::App app{"nimbus: renders functionally specified objects and participating media"};
   app.set_version_flag("--version", std::string("nimbus ") + NIMBUS_VERSION);
@@ -227,11 +249,11 @@ int main(int argc, char** argv) {
                      "Output image; repeatable; .exr (linear float) or .png (8-bit sRGB). "
                      "Default: <scene stem>.exr and .png in the current directory");
   render->add_option("--spp", args.spp, "Samples per pixel (overrides integrator.spp)")
-      ->check(CLI::PositiveNumber);
+      ->check(integer_at_least(1));
   render->add_option("--seed", args.seed, "Random seed (overrides integrator.seed)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(integer_at_least(0, std::numeric_limits<long long>::max()));
   render->add_option("--threads", args.threads, "Worker threads (default: all cores)")
-      ->check(CLI::PositiveNumber);
+      ->check(integer_at_least(1, 4096));
   render->add_option("--set", args.sets,
                      "Override a scene key: --set integrator.spp=16 (dotted path, JSON value); "
                      "repeatable");
@@ -248,9 +270,10 @@ int main(int argc, char** argv) {
   experiment->add_option("--out", exp.out, "Directory for the results (created if missing)")
       ->required();
   experiment->add_flag("--quick", exp.quick, "A tiny variant that runs in seconds");
-  experiment->add_option("--seed", exp.seed, "Random seed")->check(CLI::NonNegativeNumber);
+  experiment->add_option("--seed", exp.seed, "Random seed")
+      ->check(integer_at_least(0, std::numeric_limits<long long>::max()));
   experiment->add_option("--threads", exp.threads, "Worker threads (default: all cores)")
-      ->check(CLI::PositiveNumber);
+      ->check(integer_at_least(1, 4096));
   experiment->add_option("--scenes", exp.scenes, "Directory of the scene files")
       ->capture_default_str();
   experiment->add_flag("--no-plot", exp.no_plot, "Write the CSV files only");

@@ -156,7 +156,25 @@ TEST_F(Cli, UsageErrorsExitTwo) {
   write("scene.json", good_scene().dump());
   EXPECT_EQ(run("").code, 2);
   EXPECT_EQ(run("render").code, 2);
-  EXPECT_EQ(run("render scene.json --spp 0").code, 2);
+  // Range errors say the range in words (issue 16), not CLI11's double bounds.
+  const Outcome spp0 = run("render scene.json --spp 0");
+  EXPECT_EQ(spp0.code, 2);
+  EXPECT_NE(spp0.err.find("--spp: must be >= 1, not 0"), std::string::npos) << spp0.err;
+  const Outcome huge = run("render scene.json --spp 1099511627776");
+  EXPECT_EQ(huge.code, 2);
+  EXPECT_NE(huge.err.find("--spp: must be <= 2147483647, not 1099511627776"), std::string::npos)
+      << huge.err;
+  const Outcome threads0 = run("render scene.json --threads 0");
+  EXPECT_EQ(threads0.code, 2);
+  EXPECT_NE(threads0.err.find("--threads: must be >= 1, not 0"), std::string::npos) << threads0.err;
+  const Outcome words = run("render scene.json --seed many");
+  EXPECT_EQ(words.code, 2);
+  EXPECT_NE(words.err.find("--seed: must be a whole number, not \"many\""), std::string::npos)
+      << words.err;
+  const Outcome set_huge = run("render scene.json --set integrator.spp=1099511627776");
+  EXPECT_EQ(set_huge.code, 2);
+  EXPECT_EQ(set_huge.err,
+            "--set integrator.spp=1099511627776: /integrator/spp: must be in [1, 2147483647]\n");
   EXPECT_EQ(run("render scene.json --bogus").code, 2);
   const Outcome missing = run("render nowhere.json");
   EXPECT_EQ(missing.code, 2);

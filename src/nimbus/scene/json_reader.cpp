@@ -107,7 +107,13 @@ int JsonValue::integer(const Range& range) const {
   const double x = json_->is_number_unsigned() ? static_cast<double>(json_->get<uint64_t>())
                                                : static_cast<double>(json_->get<int64_t>());
   check(x, range);
-  check(x, between(std::numeric_limits<int>::min(), std::numeric_limits<int>::max()));
+  // Beyond int's range, the message gives the range that is really accepted: the caller's
+  // within int's.
+  Range r = range;
+  constexpr double kMin = std::numeric_limits<int>::min(), kMax = std::numeric_limits<int>::max();
+  if (!r.lo || *r.lo < kMin) r.lo = kMin, r.lo_open = false;
+  if (!r.hi || *r.hi > kMax) r.hi = kMax, r.hi_open = false;
+  check(x, r);
   return static_cast<int>(x);
 }
 
