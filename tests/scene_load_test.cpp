@@ -1,4 +1,6 @@
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -653,6 +655,27 @@ TEST_F(SceneFileTest, MissingFileIsAnError) {
   const std::string path = (dir_ / "none.json").string();
   EXPECT_EQ(file_error(path), path + ": cannot open file (No such file or directory)");
   EXPECT_EQ(file_error(dir_.string()), dir_.string() + ": cannot open file (is a directory)");
+}
+
+// Issue 16: a FIFO as the scene path hung with no word, and /dev/zero grew to 16.8 GB; a binary
+// or oversized file is refused before it is parsed.
+TEST_F(SceneFileTest, OnlyRegularUtf8FilesOfBoundedSizeAreRead) {
+  const std::string fifo = (dir_ / "fifo.json").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_EQ(file_error(fifo), fifo + ": not a regular file (a FIFO)");
+  EXPECT_EQ(file_error("/dev/zero"), "/dev/zero: not a regular file (a character device)");
+  const std::string binary = write(std::string("{\"film\": \xff}"));
+  EXPECT_EQ(file_error(binary), binary + ": not UTF-8 text (byte 9)");
+  const std::string cut = write(std::string("{\"a\": \"\xc3"));
+  EXPECT_EQ(file_error(cut), cut + ": not UTF-8 text (byte 7)");
+  const std::string ok = write(std::string("{\"film\": {\"width\": 8}} // caf\xc3\xa9"));
+  EXPECT_EQ(file_error(ok).find("UTF-8"), std::string::npos) << file_error(ok);
+  const std::string big = (dir_ / "big.json").string();
+  std::ofstream(big) << "{}";
+  std::filesystem::resize_file(big, kMaxSceneFileBytes + 1);  // sparse: costs no disk
+  EXPECT_EQ(file_error(big), fmt::format("{}: the file has {} bytes; a scene file may have at "
+                                         "most {}",
+                                         big, kMaxSceneFileBytes + 1, kMaxSceneFileBytes));
 }
 
 }  // namespace

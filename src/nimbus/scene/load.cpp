@@ -476,16 +476,55 @@ class Loader {
   std::map<std::string, int> media_index_;
 };
 
+// The first byte offset at which `text` is not well-formed UTF-8, or npos.
+size_t invalid_utf8_at(std::string_view text) {
+  size_t i = 0;
+  while (i < text.size()) {
+    const auto b = static_cast<unsigned char>(text[i]);
+    const int n = b < 0x80           ? 0
+                  : (b >> 5) == 0x6  ? 1
+                  : (b >> 4) == 0xe  ? 2
+                  : (b >> 3) == 0x1e ? 3
+                                     : -1;
+    if (n < 0 || i + n >= text.size() + (n == 0 ? 1 : 0)) return i;
+    for (int k = 1; k <= n; ++k)
+      if ((static_cast<unsigned char>(text[i + k]) >> 6) != 0x2) return i;
+    i += n + 1;
+  }
+  return std::string_view::npos;
+}
+
+// The scene file's text: a regular file of at most kMaxSceneFileBytes, in UTF-8. Anything else
+// (a directory, a FIFO that would block, /dev/zero that never ends, a binary file) is one line.
 std::string read_file(const std::string& path) {
-  if (std::filesystem::is_directory(path))
-    throw SceneError(path + ": cannot open file (is a directory)");
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (fs::is_directory(st)) throw SceneError(path + ": cannot open file (is a directory)");
+  if (fs::exists(st) && !fs::is_regular_file(st))
+    throw SceneError(path + ": not a regular file (" +
+                     (fs::is_fifo(st)             ? "a FIFO"
+                      : fs::is_character_file(st) ? "a character device"
+                      : fs::is_block_file(st)     ? "a block device"
+                      : fs::is_socket(st)         ? "a socket"
+                                                  : "not a file") +
+                     ")");
+  if (fs::exists(st)) {
+    const auto size = fs::file_size(path, ec);
+    if (!ec && size > kMaxSceneFileBytes)
+      throw SceneError(fmt::format("{}: the file has {} bytes; a scene file may have at most {}",
+                                   path, size, kMaxSceneFileBytes));
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw SceneError(fmt::format("{}: cannot open file ({})", path, std::strerror(errno)));
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad())
     throw SceneError(fmt::format("{}: cannot read file ({})", path, std::strerror(errno)));
-  return text.str();
+  std::string s = text.str();
+  if (const size_t at = invalid_utf8_at(s); at != std::string_view::npos)
+    throw SceneError(fmt::format("{}: not UTF-8 text (byte {})", path, at));
+  return s;
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // every error is a SceneError whose message is one line, "SOURCE: /json/pointer: problem", where
 // SOURCE is the file name, or the "--set KEY=VALUE" flag that put the offending value in place.
 
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -13,6 +14,12 @@
 namespace nimbus {
 
 // Reads, parses (comments allowed), applies the overrides in order and validates.
+// The largest scene file read: far above any scene written by hand or exported, far below
+// what would exhaust memory.
+inline constexpr std::uintmax_t kMaxSceneFileBytes = std::uintmax_t{64} << 20;
+
+// Reads, parses and validates a scene file; every problem is one SceneError line naming the
+// file and, inside it, the JSON path.
 SceneDesc load_scene_file(const std::string& path, const std::vector<std::string>& overrides = {});
 
 // As load_scene_file for a document already in memory; `source` names it in messages.
