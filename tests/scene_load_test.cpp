@@ -657,6 +657,19 @@ TEST_F(SceneFileTest, MissingFileIsAnError) {
   EXPECT_EQ(file_error(dir_.string()), dir_.string() + ": cannot open file (is a directory)");
 }
 
+// Issue 16: a key given twice in one object was silently merged (one of them won).
+TEST_F(SceneFileTest, DuplicateKeysAreAnErrorAtTheirPath) {
+  std::string path = write(R"({"film": {"width": 8, "height": 4, "width": 9}})");
+  EXPECT_EQ(file_error(path), path + R"(: /film/width: duplicate key "width")");
+  path = write(R"({"lights": [{"type": "environment"}, {"type": "point", "type": "sphere"}]})");
+  EXPECT_EQ(file_error(path), path + R"(: /lights/1/type: duplicate key "type")");
+  path = write(R"({"shapes": {"a/b": {}, "c": [[1, {"k": 1, "k": 2}]]}})");
+  EXPECT_EQ(file_error(path), path + R"(: /shapes/c/0/1/k: duplicate key "k")");
+  // The same key in different objects is no duplicate.
+  path = write(R"({"film": {"width": 8}, "camera": {"width": 2}})");
+  EXPECT_EQ(file_error(path).find("duplicate"), std::string::npos) << file_error(path);
+}
+
 // Issue 16: a FIFO as the scene path hung with no word, and /dev/zero grew to 16.8 GB; a binary
 // or oversized file is refused before it is parsed.
 TEST_F(SceneFileTest, OnlyRegularUtf8FilesOfBoundedSizeAreRead) {

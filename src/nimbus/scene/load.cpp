@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "nimbus/frep/primitives.h"
@@ -588,10 +589,69 @@ SceneDesc load_scene_json(nlohmann::json j, const std::string& source,
   return Loader(JsonValue(j, "", origin)).load();
 }
 
+// A parser callback that refuses a key given twice in one object (the JSON standard leaves it
+// open; nlohmann's parser keeps one of them silently), naming its JSON path.
+class DuplicateKeys {
+ public:
+  explicit DuplicateKeys(const std::string& source) : source_(source) {}
+  bool operator()(int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+    using E = nlohmann::json::parse_event_t;
+    switch (event) {
+      case E::object_start:
+      case E::array_start:
+        enter_element();
+        frames_.push_back({event == E::array_start,
+                           -1,
+                           {},
+                           frames_.empty() ? "" : child_pointer(here(), key_or_index()),
+                           {}});
+        break;
+      case E::key: {
+        Frame& f = frames_.back();
+        f.key = parsed.get<std::string>();
+        if (!f.keys.insert(f.key).second)
+          throw SceneError(fmt::format("{}: {}: duplicate key \"{}\"", source_,
+                                       child_pointer(f.pointer, f.key), f.key));
+        break;
+      }
+      case E::value:
+        enter_element();
+        break;
+      case E::object_end:
+      case E::array_end:
+        frames_.pop_back();
+        break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool array;
+    long index;  // arrays: the element being read
+    std::set<std::string> keys;
+    std::string pointer;  // of this container
+    std::string key;      // objects: the key being read
+  };
+  void enter_element() {
+    if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
+  }
+  // The parent's pointer and the token under which the container now opening sits.
+  std::string here() const { return frames_.empty() ? "" : frames_.back().pointer; }
+  std::string key_or_index() const {
+    if (frames_.empty()) return "";
+    const Frame& f = frames_.back();
+    return f.array ? std::to_string(f.index) : f.key;
+  }
+  const std::string& source_;
+  std::vector<Frame> frames_;
+};
+
 SceneDesc load_scene_file(const std::string& path, const std::vector<std::string>& overrides) {
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(read_file(path), nullptr, true, /*ignore_comments=*/true);
+    j = nlohmann::json::parse(read_file(path), DuplicateKeys(path), true,
+                              /*ignore_comments=*/true);
   } catch (const nlohmann::json::exception& e) {
     // what() is "[json.exception.parse_error.101] parse error at line 3, column 5: ..." (or an
     // out_of_range error for numbers beyond double).
