@@ -351,6 +351,17 @@ std::vector<BadScene> bad_scenes() {
        with_camera(""),
        {"integrator.spp"},
        "--set integrator.spp: expected KEY=VALUE"},
+      // Issue 16: a key that --set created is blamed on --set, not on the file.
+      {"--set creates an unknown object",
+       with_camera(""),
+       {"newthing.x=1"},
+       "--set newthing.x=1: /newthing: unknown key"},
+      // Issue 16: a long value is not echoed whole.
+      {"--set with a long value",
+       with_camera(""),
+       {"film.width=\"" + std::string(300, 'a') + "\""},
+       "--set film.width=\"" + std::string(48, 'a') +
+           "... (313 characters): /film/width: expected an integer, not a string"},
       {"--set past an array's end",
        with_camera(R"("lights": [])"),
        {"lights.0.radiance=1"},
@@ -596,10 +607,14 @@ TEST(SceneLoad, OverrideCreatesMissingSections) {
   EXPECT_EQ(s.integrator.tracking.majorant_source, TrackingSettings::MajorantSource::Sample);
 }
 
-TEST(SceneLoad, OverrideReturnsTheEscapedPointer) {
+TEST(SceneLoad, OverrideReturnsTheEscapedPointerOfWhatItOwns) {
   nlohmann::json j = nlohmann::json::object();
-  EXPECT_EQ(apply_override(j, "shapes.a/b~c.radius=2"), "/shapes/a~1b~0c/radius");
+  // It created "shapes": everything below is the override's.
+  EXPECT_EQ(apply_override(j, "shapes.a/b~c.radius=2"), "/shapes");
   EXPECT_EQ(j["shapes"]["a/b~c"]["radius"], 2);
+  // Now only the value is new.
+  EXPECT_EQ(apply_override(j, "shapes.a/b~c.radius=3"), "/shapes/a~1b~0c/radius");
+  EXPECT_EQ(apply_override(j, "shapes.a/b~c.center=[0, 0, 0]"), "/shapes/a~1b~0c/center");
   EXPECT_EQ(apply_override(j, "note=two words"), "/note");
   EXPECT_EQ(j["note"], "two words");
 }

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -530,9 +531,18 @@ std::string read_file(const std::string& path) {
 
 }  // namespace
 
+// "--set KEY=VALUE" as messages show it: a value of any length (up to 240 kB were echoed) is
+// cut after 60 characters.
+std::string set_flag(const std::string& key_equals_value) {
+  constexpr size_t kShown = 60;
+  if (key_equals_value.size() <= kShown + 20) return "--set " + key_equals_value;
+  return fmt::format("--set {}... ({} characters)", key_equals_value.substr(0, kShown),
+                     key_equals_value.size());
+}
+
 std::string apply_override(nlohmann::json& j, const std::string& key_equals_value) {
   const auto fail = [&](const std::string& problem) {
-    throw SceneError(fmt::format("--set {}: {}", key_equals_value, problem));
+    throw SceneError(fmt::format("{}: {}", set_flag(key_equals_value), problem));
   };
   const size_t eq = key_equals_value.find('=');
   if (eq == std::string::npos) fail("expected KEY=VALUE");
@@ -550,7 +560,12 @@ std::string apply_override(nlohmann::json& j, const std::string& key_equals_valu
 
   nlohmann::json* cur = &j;
   std::string pointer, dotted;
+  // The outermost key this override creates: what lies below it is the override's, not the
+  // file's, and messages about it name the flag.
+  std::optional<std::string> created;
   for (const std::string& part : parts) {
+    const bool missing = cur->is_null() || (cur->is_object() && !cur->contains(part));
+    if (missing && !created) created = child_pointer(pointer, part);
     if (cur->is_array()) {
       const bool digits =
           part.find_first_not_of("0123456789") == std::string::npos && part.size() < 10;
@@ -578,14 +593,14 @@ std::string apply_override(nlohmann::json& j, const std::string& key_equals_valu
     value = text;  // a bare word such as perspective
   }
   *cur = std::move(value);
-  return pointer;
+  return created.value_or(pointer);
 }
 
 SceneDesc load_scene_json(nlohmann::json j, const std::string& source,
                           const std::vector<std::string>& overrides) {
   JsonOrigin origin{source, {}};
   for (const std::string& o : overrides)
-    origin.overrides.push_back({apply_override(j, o), "--set " + o});
+    origin.overrides.push_back({apply_override(j, o), set_flag(o)});
   return Loader(JsonValue(j, "", origin)).load();
 }
 

@@ -29,8 +29,9 @@ SceneDesc load_scene_json(nlohmann::json j, const std::string& source,
 // Applies one `--set KEY=VALUE`: KEY is a dotted path into the document (array elements by
 // index, as in lights.0.radiance), VALUE is parsed as JSON or else taken as a string. Missing
 // object keys along the path are created; a path through a value that is neither an object nor
-// an array, or past the end of an array, is an error "--set KEY=VALUE: problem". Returns the
-// JSON pointer of the value it set.
+// an array, or past the end of an array, is an error "--set KEY=VALUE: problem" (a long value
+// cut short). Returns the JSON pointer of what the override owns, which later messages blame on
+// it: the outermost key it created, or else the value it set.
 std::string apply_override(nlohmann::json& j, const std::string& key_equals_value);
 
 }  // namespace nimbus
