@@ -5,7 +5,9 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -38,6 +40,31 @@ struct RenderArgs {
   std::string stats;
   bool quiet = false;
 };
+
+// SIGINT, SIGTERM and SIGHUP: the first one during a render stops it before its next tile
+// (nothing is written, exit 128 + the signal's number); during writing, or a second one, removes
+// every temporary file and ends the process by the signal at once.
+std::atomic<int> g_signal{0};
+std::atomic<bool> g_writing{false};
+
+extern "C" void on_stop_signal(int sig) {
+  if (g_signal.exchange(sig) != 0 || g_writing.load()) {
+    nimbus::remove_temporary_files_now();
+    std::signal(sig, SIG_DFL);
+    std::raise(sig);
+  }
+}
+
+void catch_stop_signals() {
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, on_stop_signal);
+}
+
+const char* signal_name(int sig) {
+  return sig == SIGINT    ? "SIGINT"
+         : sig == SIGTERM ? "SIGTERM"
+         : sig == SIGHUP  ? "SIGHUP"
+                          : "a signal";
+}
 
 void print_progress(double fraction, double elapsed) {
   const int width = 40, filled = static_cast<int>(fraction * width);
@@ -77,6 +104,7 @@ int run_render(const RenderArgs& args) {
 
   RenderOptions options;
   options.threads = args.threads;
+  options.cancel = [] { return g_signal.load() != 0; };
   const bool show_progress = !args.quiet && isatty(fileno(stderr));
   const auto start = std::chrono::steady_clock::now();
   if (show_progress)
@@ -86,20 +114,24 @@ int run_render(const RenderArgs& args) {
     };
   const RenderResult result = render(scene, options);
   if (show_progress) std::fprintf(stderr, "\n");
+  if (const int sig = g_signal.load(); sig != 0) {
+    std::fprintf(stderr, "nimbus: stopped by %s before the render finished; nothing written\n",
+                 signal_name(sig));
+    return 128 + sig;
+  }
   if (const uint64_t n = result.counters.rejected_samples; n > 0)
     std::fprintf(stderr,
                  "nimbus: warning: %llu samples were NaN or infinite and counted as 0 "
                  "(counters.rejected_samples in --stats)\n",
                  static_cast<unsigned long long>(n));
 
-  // All or nothing: if one output cannot be written, remove those already written.
-  std::vector<std::string> written;
+  // All or nothing: every output is written to its temporary file first, and only when all are
+  // complete are they renamed into place (io/atomic_file.h).
+  g_writing = true;
   try {
+    OutputTransaction outputs_of_this_run;
     const Image image = to_image(result.film);
-    for (const std::string& out : outputs) {
-      write_image(out, image);
-      written.push_back(out);
-    }
+    for (const std::string& out : outputs) write_image(out, image);
     if (!args.stats.empty()) {
       const std::string text = render_stats(scene, result, args.scene).dump(2) + "\n";
       write_atomically(args.stats, [&](const std::string& tmp) {
@@ -108,11 +140,13 @@ int run_render(const RenderArgs& args) {
         if (!f) throw std::runtime_error("cannot write");
       });
     }
+    outputs_of_this_run.commit();
   } catch (const std::exception& e) {
-    for (const std::string& w : written) std::filesystem::remove(w);
+    g_writing = false;
     std::fprintf(stderr, "nimbus: %s\n", e.what());
     return kExitFailure;
   }
+  g_writing = false;
   if (!args.quiet) {
     const double samples =
         double(scene.settings.width) * scene.settings.height * scene.settings.spp;
@@ -286,6 +320,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (experiment->parsed()) return run_experiment(exp);
+    catch_stop_signals();
     return run_render(args);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "nimbus: %s\n", e.what());

@@ -269,6 +269,31 @@ TEST_F(Cli, RendersInSpectralModeFromTheCommandLine) {
   EXPECT_FALSE(fs::exists(dir_ / "bad.exr"));
 }
 
+// Issue 16: SIGINT and SIGTERM stop a render cleanly: exit 128 + the signal, one line, and no
+// output or temporary file left behind.
+TEST_F(Cli, SignalsStopTheRenderAndWriteNothing) {
+  write("scene.json", good_scene().dump());
+  for (const auto& [sig, code] : {std::pair<const char*, int>{"INT", 130}, {"TERM", 143}}) {
+    const std::string script =
+        std::string("cd '") + dir_.string() + "' && ('" + NIMBUS_BINARY +
+        "' render scene.json --spp 20000 -o out.png -o out.exr --stats s.json 2>err.txt & "
+        "pid=$!; sleep 1; kill -" +
+        sig + " $pid; wait $pid; echo $? > code.txt)";
+    ASSERT_EQ(std::system(script.c_str()), 0);
+    std::ifstream code_file(dir_ / "code.txt"), err_file(dir_ / "err.txt");
+    int exit_code = -1;
+    code_file >> exit_code;
+    EXPECT_EQ(exit_code, code) << sig;
+    std::stringstream err;
+    err << err_file.rdbuf();
+    EXPECT_NE(err.str().find("before the render finished; nothing written"), std::string::npos)
+        << err.str();
+    fs::remove(dir_ / "code.txt");
+    fs::remove(dir_ / "err.txt");
+    EXPECT_TRUE(outputs().empty()) << outputs().front();
+  }
+}
+
 TEST_F(Cli, OutputIsTheSameForOneAndTwoThreads) {
   write("scene.json", good_scene().dump());
   ASSERT_EQ(run("render scene.json -o one.exr --threads 1 --quiet").code, 0);

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 #include <png.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -8,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -193,6 +196,66 @@ TEST_F(IoTest, OutputPathIsCheckedUpfront) {
   EXPECT_EQ(error_of([&] { check_output_path(path("d.png")); }),
             path("d.png") + ": is a directory");
   EXPECT_EQ(error_of([] { check_output_path("relative.png"); }), "(no error)");
+  // Issue 16: /dev was accepted as an output folder, so /dev/full.exr was written.
+  EXPECT_EQ(error_of([] { check_output_path("/dev/full.exr"); }),
+            "/dev/full.exr: refusing to write into /dev (a folder of devices and kernel files)");
+  EXPECT_EQ(error_of([] { check_output_path("/proc/self/x.png"); }).rfind("/proc/self/x.png: ", 0),
+            0u);
+  ASSERT_EQ(::mkfifo(path("pipe.png").c_str(), 0600), 0);
+  EXPECT_EQ(error_of([&] { check_output_path(path("pipe.png")); }),
+            path("pipe.png") + ": exists and is not a regular file");
+}
+
+// Issue 16: the outputs of one run are renamed into place together, after all are complete; a
+// failure or an early end leaves neither new files nor temporaries.
+TEST_F(IoTest, OutputTransactionRenamesAllOrNothing) {
+  std::ofstream(path("a.png")) << "old a";
+  std::ofstream(path("b.exr")) << "old b";
+  {
+    OutputTransaction t;
+    write_image(path("a.png"), test_image(4, 3));
+    EXPECT_EQ(listing().size(), 3u) << "a.png, b.exr and a.png's temporary";
+    EXPECT_EQ(error_of([&] {
+                write_atomically(path("b.exr"),
+                                 [](const std::string&) { throw std::runtime_error("disk full"); });
+              }),
+              path("b.exr") + ": disk full");
+    // The run gives up without commit().
+  }
+  EXPECT_EQ(listing(), (std::vector<std::string>{"a.png", "b.exr"}));
+  std::ifstream old_a(path("a.png"));
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(old_a), {}), "old a");
+  {
+    OutputTransaction t;
+    write_image(path("a.png"), test_image(4, 3));
+    write_image(path("b.exr"), test_image(4, 3));
+    std::ifstream still_old(path("b.exr"));
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(still_old), {}), "old b")
+        << "nothing is in place before commit";
+    t.commit();
+  }
+  EXPECT_EQ(listing(), (std::vector<std::string>{"a.png", "b.exr"}));
+  EXPECT_EQ(read_exr(path("b.exr")).width, 4);
+}
+
+// Issue 16: a run killed outright (SIGKILL) leaves its temporary; the next run that writes the
+// same output removes it, but not the temporary of a process that is still alive.
+TEST_F(IoTest, TemporariesOfDeadRunsAreRemovedByTheNextWrite) {
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) ::_exit(0);
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);  // its pid is now free: a dead run's
+  const std::string dead = "out.png.tmp-" + std::to_string(child) + "-0";
+  const std::string alive = "out.png.tmp-" + std::to_string(::getpid()) + "-999";
+  std::ofstream(path(dead)) << "half an image";
+  std::ofstream(path(alive)) << "being written";
+  std::ofstream(path("other.png.tmp-" + std::to_string(child) + "-0")) << "not ours";
+  write_image(path("out.png"), test_image(2, 2));
+  std::vector<std::string> expected = {alive, "other.png.tmp-" + std::to_string(child) + "-0",
+                                       "out.png"};
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(listing(), expected);
 }
 
 }  // namespace

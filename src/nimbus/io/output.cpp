@@ -52,6 +52,14 @@ void check_writable_path(const std::string& path) {
   if (::access(dir.c_str(), W_OK) != 0)
     throw std::runtime_error(path + ": directory " + dir.string() + " is not writable");
   if (fs::is_directory(path, ec)) throw std::runtime_error(path + ": is a directory");
+  // Files there are devices and kernel interfaces, not images: /dev/full.exr was written.
+  const std::string real = fs::weakly_canonical(fs::absolute(dir), ec).string();
+  for (const char* special : {"/dev", "/proc", "/sys"})
+    if (real == special || real.rfind(std::string(special) + "/", 0) == 0)
+      throw std::runtime_error(path + ": refusing to write into " + special +
+                               " (a folder of devices and kernel files)");
+  if (fs::exists(path, ec) && !fs::is_regular_file(path, ec))
+    throw std::runtime_error(path + ": exists and is not a regular file");
 }
 
 }  // namespace nimbus

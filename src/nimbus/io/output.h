@@ -13,7 +13,8 @@ namespace nimbus {
 void write_image(const std::string& path, const Image& image);
 
 // Throws std::runtime_error("PATH: problem") unless the extension is known, the directory exists
-// and is writable, and the path is not itself a directory.
+// and is writable and is not /dev, /proc or /sys (or inside them), and the path is not itself a
+// directory or another file that is not a regular one.
 void check_output_path(const std::string& path);
 
 // The same check for a file of any kind: the directory exists and is writable, and the path is

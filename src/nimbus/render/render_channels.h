@@ -39,15 +39,15 @@ RenderStats render_channels(const Scene& scene, Film& film, const RenderRange& r
   tbb::parallel_for(
       tbb::blocked_range2d<int>(range.y0, range.y1, kTile, range.x0, range.x1, kTile),
       [&](const tbb::blocked_range2d<int>& tile) {
-        if (cancelled || (options.cancel && options.cancel())) {
-          cancelled = true;
-          return;
-        }
         Counters& local = counters.local();
         PathSpectra<N>& ps = spectra.local();
         if (!spectral) prepare_path_spectra(ps, scene, 0.0);
         for (int y = tile.rows().begin(); y < tile.rows().end(); ++y)
           for (int x = tile.cols().begin(); x < tile.cols().end(); ++x) {
+            if (cancelled.load(std::memory_order_relaxed) || (options.cancel && options.cancel())) {
+              cancelled = true;
+              return;
+            }
             const int pixel = y * W + x;
             for (int s = range.s0; s < range.s1; ++s) {
               Rng rng = Rng::for_sample(scene.settings.seed, uint64_t(pixel), uint64_t(s));

@@ -24,8 +24,8 @@ struct RenderOptions {
   // Called now and then with the fraction of the range done, from one thread at a time.
   std::function<void(double)> progress;
   RenderRange range;
-  // Polled before each tile, possibly from several threads at once; once it returns true no
-  // tile starts: every pixel then holds either all of the range's samples or none of them.
+  // Polled before each pixel, possibly from several threads at once; once it returns true no
+  // pixel starts: every pixel then holds either all of the range's samples or none of them.
   std::function<bool()> cancel;
 };
 
