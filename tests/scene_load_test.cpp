@@ -602,6 +602,33 @@ TEST(SceneLoad, OverridesReplaceAndCreateValues) {
   EXPECT_EQ(s.integrator.tracking.octree_depth, 3);
 }
 
+// Issue 16: inline unions nested 5 000 deep and chains of 30 000 named aliases crashed the
+// loader (stack overflow). Beyond kMaxShapeDepth levels they are one error at the place.
+TEST(SceneLoad, DeeplyNestedShapesAreAnErrorNotACrash) {
+  std::string text = R"({"type": "sphere", "radius": 1})";
+  for (int i = 0; i < 5000; ++i) text = R"({"type": "union", "shapes": [)" + text + "]}";
+  const std::string nested = load_error(with_object(R"({"shape": )" + text + "}"));
+  std::string at = "/objects/0/shape";
+  for (int i = 0; i < kMaxShapeDepth; ++i) at += "/shapes/0";
+  EXPECT_EQ(nested, "scene.json: " + at + ": shapes nest more than " +
+                        std::to_string(kMaxShapeDepth) +
+                        " levels deep here (inline shapes, bases, perturbations, children and "
+                        "named references together)");
+
+  std::string shapes;
+  for (int i = 0; i < 30000; ++i)
+    shapes += "\"s" + std::to_string(i) + "\": \"s" + std::to_string(i + 1) + "\", ";
+  shapes += R"("s30000": {"type": "sphere", "radius": 1})";
+  const std::string chain = load_error(with_camera(R"("shapes": {)" + shapes + "}"));
+  EXPECT_NE(chain.find("shapes nest more than"), std::string::npos) << chain.substr(0, 200);
+
+  // Up to the limit, nesting is fine.
+  std::string ok = R"({"type": "sphere", "radius": 1})";
+  for (int i = 1; i < kMaxShapeDepth - 1; ++i)
+    ok = R"({"type": "union", "shapes": [)" + ok + "]}";
+  EXPECT_EQ(load_error(with_object(R"({"shape": )" + ok + "}")), "(no error)");
+}
+
 TEST(SceneLoad, OverrideCreatesMissingSections) {
   const SceneDesc s = load(with_camera(""), {"integrator.majorant.source=sample"});
   EXPECT_EQ(s.integrator.tracking.majorant_source, TrackingSettings::MajorantSource::Sample);

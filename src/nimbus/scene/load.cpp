@@ -348,7 +348,20 @@ class Loader {
   }
 
   // A shape where one is expected: the name of a shape in "shapes", or an inline shape object.
+  // Shapes nest through inline children, free-form bases and perturbations and named references
+  // alike; beyond kMaxShapeDepth levels the loader and the compiler's recursion would exhaust the
+  // stack (5 000 nested unions crashed it), so that is an error at the place it is exceeded.
   ShapePtr shape(const JsonValue& v) {
+    struct Level {
+      int& depth;
+      explicit Level(int& d) : depth(++d) {}
+      ~Level() { --depth; }
+    } level(shape_depth_);
+    if (shape_depth_ > kMaxShapeDepth)
+      v.fail(
+          fmt::format("shapes nest more than {} levels deep here (inline shapes, bases, "
+                      "perturbations, children and named references together)",
+                      kMaxShapeDepth));
     if (v.json().is_object()) return inline_shape(v);
     if (!v.json().is_string()) v.fail("expected a shape name or an inline shape object");
     const std::string name = v.string();
@@ -474,6 +487,7 @@ class Loader {
   JsonObject root_;
   std::optional<JsonObject> shapes_;
   std::map<std::string, ShapePtr> built_;
+  int shape_depth_ = 0;           // shapes being read, one inside the other
   std::vector<Visit> resolving_;  // named shapes being built, outermost first
   std::map<std::string, int> media_index_;
 };

@@ -14,6 +14,9 @@
 namespace nimbus {
 
 // Reads, parses (comments allowed), applies the overrides in order and validates.
+// How deeply shapes may nest in a scene file (docs/scene-format.md).
+inline constexpr int kMaxShapeDepth = 256;
+
 // The largest scene file read: far above any scene written by hand or exported, far below
 // what would exhaust memory.
 inline constexpr std::uintmax_t kMaxSceneFileBytes = std::uintmax_t{64} << 20;
