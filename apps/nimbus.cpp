@@ -14,12 +14,15 @@
 #include <fstream>
 #include <limits>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "nimbus/experiments/experiment.h"
 #include "nimbus/io/atomic_file.h"
 #include "nimbus/io/film_image.h"
 #include "nimbus/io/output.h"
+#include "nimbus/render/memory_estimate.h"
+#include "nimbus/render/path_spectra.h"
 #include "nimbus/render/renderer.h"
 #include "nimbus/render/stats.h"
 #include "nimbus/scene/compile.h"
@@ -38,6 +41,7 @@ struct RenderArgs {
   long long seed = -1;
   int threads = 0;
   std::string stats;
+  std::string max_memory;  // empty: the system's available memory
   bool quiet = false;
 };
 
@@ -94,9 +98,50 @@ int run_render(const RenderArgs& args) {
     return kExitBadInput;
   }
 
+  SceneDesc desc;
+  try {
+    desc = load_scene_file(args.scene, overrides);
+  } catch (const SceneError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitBadInput;
+  }
+
+  // Refuse what the machine cannot hold before allocating it (render/memory_estimate.h).
+  {
+    int octrees = 1;
+    for (const ObjectDesc& o : desc.objects)
+      octrees += o.medium >= 0 && o.surface.type == SurfaceDesc::Type::Dielectric;
+    const int bins = desc.spectrum.mode == SpectralSettings::Mode::Spectral ? kSpectralBins : 3;
+    const int threads = args.threads > 0 ? args.threads : int(std::thread::hardware_concurrency());
+    const MemoryEstimate need =
+        estimate_render_memory(desc.film.width, desc.film.height, octrees, bins, threads);
+    std::uint64_t limit = 0;
+    std::string source = "available";
+    try {
+      if (!args.max_memory.empty()) {
+        limit = parse_memory_size(args.max_memory);
+        source = "allowed by --max-memory";
+      } else {
+        limit = available_memory();
+      }
+    } catch (const std::invalid_argument& e) {
+      std::fprintf(stderr, "nimbus: --max-memory: %s\n", e.what());
+      return kExitBadInput;
+    }
+    if (limit > 0 && need.total() > double(limit)) {
+      std::fprintf(stderr,
+                   "nimbus: the render needs about %s (film %s, image %s, majorant octrees %s), "
+                   "more than the %s %s\n",
+                   format_memory(need.total()).c_str(), format_memory(need.film).c_str(),
+                   format_memory(need.image).c_str(), format_memory(need.octrees).c_str(),
+                   format_memory(double(limit)).c_str(), source.c_str());
+      return kExitBadInput;
+    }
+  }
+
   Scene scene;
   try {
-    scene = compile_scene(load_scene_file(args.scene, overrides));
+    scene = compile_scene(desc);
   } catch (const SceneError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return kExitBadInput;
@@ -292,6 +337,9 @@ int main(int argc, char** argv) {
                      "Override a scene key: --set integrator.spp=16 (dotted path, JSON value); "
                      "repeatable");
   render->add_option("--stats", args.stats, "Write render statistics as JSON to this file");
+  render->add_option("--max-memory", args.max_memory,
+                     "Refuse renders estimated to need more memory than this (e.g. 8G, 512M; "
+                     "default: the system's available memory)");
   render->add_flag("-q,--quiet", args.quiet, "Print nothing but errors");
 
   ExperimentArgs exp;

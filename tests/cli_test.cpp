@@ -294,6 +294,23 @@ TEST_F(Cli, SignalsStopTheRenderAndWriteNothing) {
   }
 }
 
+// Issue 16: a 16384 x 16384 film took 15.7 GB without a word. The render's memory is estimated
+// before anything large is allocated and refused past the available memory or --max-memory.
+TEST_F(Cli, RendersThatWouldNotFitAreRefusedUpFront) {
+  write("scene.json", good_scene().dump());
+  const Outcome big = run(
+      "render scene.json --set film.width=16384 --set film.height=16384 --max-memory 16G -o a.png");
+  EXPECT_EQ(big.code, 2);
+  EXPECT_EQ(big.err,
+            "nimbus: the render needs about 19.0 GiB (film 13.0 GiB, image 6.0 GiB, majorant "
+            "octrees 42.0 MiB), more than the 16.0 GiB allowed by --max-memory\n");
+  EXPECT_TRUE(outputs().empty());
+  const Outcome bad = run("render scene.json --max-memory 10x -o a.png");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_EQ(bad.err, "nimbus: --max-memory: \"10x\": unknown size suffix \"x\" (K, M, G or T)\n");
+  EXPECT_EQ(run("render scene.json --max-memory 1.5G --spp 1 -o a.png").code, 0);
+}
+
 TEST_F(Cli, OutputIsTheSameForOneAndTwoThreads) {
   write("scene.json", good_scene().dump());
   ASSERT_EQ(run("render scene.json -o one.exr --threads 1 --quiet").code, 0);

@@ -15,6 +15,7 @@
 #include "nimbus/frep/primitives.h"
 #include "nimbus/io/film_file.h"
 #include "nimbus/media/cloud_density.h"
+#include "nimbus/render/memory_estimate.h"
 #include "nimbus/render/renderer.h"
 #include "support/scene_builders.h"
 
@@ -172,6 +173,22 @@ TEST(Film, RefusesValuesThatWouldPoisonThePixel) {
   EXPECT_EQ(film.sum_sq[0], Rgb({1.0, 4.0, 9.0}));
   EXPECT_EQ(film.mean(0), Rgb({0.2, -0.4, 0.6}));
   EXPECT_EQ(film.samples[1], 0u);
+}
+
+TEST(MemoryEstimate, CountsTheFilmAndParsesSizes) {
+  const MemoryEstimate e = estimate_render_memory(100, 50, 2, 3, 4);
+  EXPECT_EQ(e.film, 100.0 * 50 * (6 * sizeof(double) + sizeof(uint32_t)));
+  EXPECT_EQ(e.image, 2 * 100.0 * 50 * 3 * sizeof(float));
+  EXPECT_GT(e.octrees, 0);
+  EXPECT_EQ(e.total(), e.film + e.image + e.octrees + e.threads);
+  EXPECT_EQ(parse_memory_size("512"), 512u);
+  EXPECT_EQ(parse_memory_size("2K"), 2048u);
+  EXPECT_EQ(parse_memory_size("1.5G"), 1536ull << 20);
+  EXPECT_EQ(parse_memory_size("1T"), 1ull << 40);
+  EXPECT_THROW(parse_memory_size("-1G"), std::invalid_argument);
+  EXPECT_THROW(parse_memory_size("lots"), std::invalid_argument);
+  EXPECT_EQ(format_memory(3.0 * (1 << 30)), "3.0 GiB");
+  EXPECT_EQ(format_memory(512.0 * (1 << 20)), "512.0 MiB");
 }
 
 TEST(Film, RoundTripsThroughAFile) {

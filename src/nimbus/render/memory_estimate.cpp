@@ -1,0 +1,72 @@
+#include "nimbus/render/memory_estimate.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+
+#include "nimbus/math/vec3.h"
+#include "nimbus/media/octree.h"
+#include "nimbus/render/film.h"
+
+namespace nimbus {
+
+MemoryEstimate estimate_render_memory(int width, int height, int octrees, int bins, int threads) {
+  const double pixels = double(width) * double(height);
+  MemoryEstimate e;
+  e.film = pixels * (2 * sizeof(Rgb) + sizeof(uint32_t));
+  // The float image, and as much again for a writer's rows (EXR slices, PNG bytes).
+  e.image = 2 * pixels * 3 * sizeof(float);
+  // At the node budget, while building: the node, its bounds, its centre and level, and the
+  // pruned copy.
+  const double per_node = sizeof(OctreeNode) + 2.0 * bins * sizeof(double) + sizeof(Vec3) + 4;
+  e.octrees = double(octrees) * double(kOctreeMaxNodes) * per_node * 2;
+  e.threads = double(threads) * (1 << 20);
+  return e;
+}
+
+std::uint64_t available_memory() {
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key;
+  std::uint64_t kib = 0;
+  std::string unit;
+  while (meminfo >> key >> kib >> unit)
+    if (key == "MemAvailable:") return kib * 1024;
+  return 0;
+}
+
+std::uint64_t parse_memory_size(const std::string& text) {
+  size_t used = 0;
+  double value = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || !(value > 0) || !std::isfinite(value))
+    throw std::invalid_argument(
+        fmt::format("\"{}\" is not a size (a positive number with K, M, G or T)", text));
+  const std::string suffix = text.substr(used);
+  double scale = 1;
+  if (suffix == "K" || suffix == "k")
+    scale = 1024.0;
+  else if (suffix == "M" || suffix == "m")
+    scale = 1024.0 * 1024;
+  else if (suffix == "G" || suffix == "g")
+    scale = 1024.0 * 1024 * 1024;
+  else if (suffix == "T" || suffix == "t")
+    scale = 1024.0 * 1024 * 1024 * 1024;
+  else if (!suffix.empty())
+    throw std::invalid_argument(
+        fmt::format("\"{}\": unknown size suffix \"{}\" (K, M, G or T)", text, suffix));
+  return static_cast<std::uint64_t>(value * scale);
+}
+
+std::string format_memory(double bytes) {
+  if (bytes >= 1024.0 * 1024 * 1024)
+    return fmt::format("{:.1f} GiB", bytes / (1024.0 * 1024 * 1024));
+  return fmt::format("{:.1f} MiB", bytes / (1024.0 * 1024));
+}
+
+}  // namespace nimbus

@@ -1,0 +1,33 @@
+#pragma once
+// What a render will hold in memory at its peak, estimated before anything large is allocated,
+// so that a request the machine cannot hold is refused with one line instead of being killed
+// by the OS (a 16384 × 16384 film took 15.7 GB without a word).
+
+#include <cstdint>
+#include <string>
+
+namespace nimbus {
+
+struct MemoryEstimate {
+  double film = 0;     // per-pixel sums, sums of squares and counts
+  double image = 0;    // the float image written from the film, and a writer's copy
+  double octrees = 0;  // majorant octrees at their node budget, while being built
+  double threads = 0;  // per-thread state of the render
+  double total() const { return film + image + octrees + threads; }
+};
+
+// For an image of width × height, `octrees` majorant octrees (the field's and one per solid
+// holding a medium) with `bins` bounds each per node, rendered on `threads` threads.
+MemoryEstimate estimate_render_memory(int width, int height, int octrees, int bins, int threads);
+
+// The memory the system can still give (MemAvailable of /proc/meminfo), or 0 when unknown.
+std::uint64_t available_memory();
+
+// Parses a size: a number of bytes with an optional binary suffix K, M, G or T ("512M", "8G",
+// "1.5G"). Throws std::invalid_argument with the problem for anything else.
+std::uint64_t parse_memory_size(const std::string& text);
+
+// "17.3 GiB", "512.0 MiB", for messages.
+std::string format_memory(double bytes);
+
+}  // namespace nimbus
