@@ -349,6 +349,28 @@ TEST(Octree, SampledBoundsNeverHideMedium) {
   }
 }
 
+// Issue 16: at depth 16 with 4 096 samples per leaf the sampling pass had not finished after
+// 60 s. It looks up at most kOctreeSampleBudget points in all, fewer per leaf in deep trees.
+TEST(Octree, SamplingPassWorkIsBounded) {
+  Scene scene;
+  scene.settings.tracking.octree_depth = 6;
+  Medium field;
+  field.sigma_s = Rgb({1.0, 2.0, 3.0});
+  field.density = make_field_density();
+  add_field_object(scene, make_shape(QuadricNode{sphere({0, 0, 0}, 1)}), field);
+  scene.settings.tracking.majorant_source = TrackingSettings::MajorantSource::Sample;
+  scene.settings.tracking.majorant_samples = 1000000;
+  const MajorantOctree tree = build_majorant_octree(scene, -1);
+  size_t leaves = 0;
+  for (const OctreeNode& n : tree.nodes) leaves += n.children < 0 && !n.empty;
+  ASSERT_GT(leaves, 100u);
+  EXPECT_LE(tree.sampled_points, kOctreeSampleBudget);
+  EXPECT_GT(tree.sampled_points, kOctreeSampleBudget - leaves);
+  // Below the budget every leaf gets what was asked for.
+  scene.settings.tracking.majorant_samples = 64;
+  EXPECT_EQ(build_majorant_octree(scene, -1).sampled_points, 64 * leaves);
+}
+
 TEST(Octree, DepthZeroIsOneNodeAndDeepTreesStayBounded) {
   const Scene flat = three_media(0);
   ASSERT_EQ(flat.field_octree.nodes.size(), 1u);

@@ -45,6 +45,9 @@ inline constexpr std::size_t kOctreeMaxNodes = std::size_t{1} << 18;
 // Sampled bounds (source "sample") keep a residual rate mu_bar − mu_c of at least this fraction
 // of the interval bounds' gap, so no heterogeneous leaf passes for homogeneous (octree.cpp).
 inline constexpr double kSampledResidualFloor = 0.05;
+// The sampling pass (source "sample") looks up at most this many points in all, spreading them
+// over the leaves: fewer than majorant_samples per leaf in deep trees.
+inline constexpr size_t kOctreeSampleBudget = size_t{1} << 24;
 // What a density lookup costs in steps of the walk, for deciding which splits pay off.
 inline constexpr double kOctreeLookupCost = 16;
 
@@ -70,6 +73,7 @@ struct MajorantOctree {
   std::vector<double> bounds;
   int depth = 0;  // deepest level reached
   double build_seconds = 0;
+  uint64_t sampled_points = 0;  // points looked up by the sampling pass (source "sample")
 
   const double* mu_bar(std::size_t node) const { return &bounds[2 * bins * node]; }
   const double* mu_c(std::size_t node) const { return &bounds[2 * bins * node + bins]; }

@@ -56,9 +56,11 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
   // All octrees together: the field's and those inside solids.
   double build_seconds = 0;
   size_t nodes = 0, bytes = 0;
+  uint64_t sampled = 0;
   int depth = 0;
   auto add = [&](const MajorantOctree& t) {
     build_seconds += t.build_seconds;
+    sampled += t.sampled_points;
     nodes += t.nodes.size();
     bytes += t.nodes.empty() ? 0 : t.bytes();
     depth = std::max(depth, t.depth);
@@ -69,7 +71,8 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
                  {"nodes", nodes},
                  {"bytes", bytes},
                  {"depth_requested", scene.settings.tracking.octree_depth},
-                 {"depth", depth}};
+                 {"depth", depth},
+                 {"sampled_points", sampled}};
   return j;
 }
 
