@@ -624,8 +624,7 @@ TEST(SceneLoad, DeeplyNestedShapesAreAnErrorNotACrash) {
 
   // Up to the limit, nesting is fine.
   std::string ok = R"({"type": "sphere", "radius": 1})";
-  for (int i = 1; i < kMaxShapeDepth - 1; ++i)
-    ok = R"({"type": "union", "shapes": [)" + ok + "]}";
+  for (int i = 1; i < kMaxShapeDepth - 1; ++i) ok = R"({"type": "union", "shapes": [)" + ok + "]}";
   EXPECT_EQ(load_error(with_object(R"({"shape": )" + ok + "}")), "(no error)");
 }
 
