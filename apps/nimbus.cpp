@@ -45,7 +45,7 @@ struct RenderArgs {
   bool quiet = false;
 };
 
-// SIGINT, SIGTERM and SIGHUP: the first one during a render stops it before its next tile
+// SIGINT, SIGTERM and SIGHUP: the first one during a render stops it before its next pixel
 // (nothing is written, exit 128 + the signal's number); during writing, or a second one, removes
 // every temporary file and ends the process by the signal at once.
 std::atomic<int> g_signal{0};

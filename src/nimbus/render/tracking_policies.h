@@ -27,20 +27,11 @@
 
 namespace nimbus {
 
-// Largest magnitude over channels: spectral tracking with a majorant that does not bound can
-// make weights negative.
-template <int N>
-double max_abs(const Spectrum<N>& x) {
-  double m = 0;
-  for (int c = 0; c < N; ++c) m = std::max(m, std::abs(x[c]));
-  return m;
-}
-
 // Continues the path with probability q = min(1, max|beta / scale|) from depth 3 on.
 template <int N>
 bool russian_roulette(Spectrum<N>& beta, double scale, int depth, Rng& rng) {
   if (depth < 3) return true;
-  const double q = std::min(1.0, max_abs(beta) / scale);
+  const double q = std::min(1.0, beta.max_abs() / scale);
   if (q <= 0 || rng.uniform() >= q) return false;
   beta /= q;  // unbiased: survivors carry 1/q
   return true;

@@ -158,10 +158,6 @@ SpectralCurve sigmoid_curve(const std::array<double, 3>& c) {
   return s;
 }
 
-double max_abs(const Rgb& r) {
-  return std::max({std::abs(r[0]), std::abs(r[1]), std::abs(r[2])});
-}
-
 // Gauss–Newton steps on interpolated coefficients: trilinear interpolation of the table misses
 // the target by up to ~1e-3, and a few steps bring reflectance_to_rgb to it at round-off wherever
 // a sigmoid reaches it. A step that does not reduce the residual is halved, and the polish stops
@@ -173,7 +169,7 @@ std::array<double, 3> polish(std::array<double, 3> c, const Rgb& target) {
     return reflectance_to_rgb(sigmoid_curve(k)) - target;
   };
   Rgb r = residual(c);
-  double error = max_abs(r);
+  double error = r.max_abs();
   for (int step = 0; step < kSteps && error > kDone; ++step) {
     double J[3][3];  // J[i][j] = ∂ r_i / ∂ c_j, by forward differences
     for (int j = 0; j < 3; ++j) {
@@ -202,10 +198,10 @@ std::array<double, 3> polish(std::array<double, 3> c, const Rgb& target) {
     for (double t = 1; t > 1.0 / 64 && !improved; t *= 0.5) {
       const std::array<double, 3> k = {c[0] + t * d[0], c[1] + t * d[1], c[2] + t * d[2]};
       const Rgb rk = residual(k);
-      if (max_abs(rk) < error) {
+      if (rk.max_abs() < error) {
         c = k;
         r = rk;
-        error = max_abs(rk);
+        error = rk.max_abs();
         improved = true;
       }
     }

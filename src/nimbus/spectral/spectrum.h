@@ -50,6 +50,12 @@ struct Spectrum {
   constexpr double min() const {
     return *std::min_element(v.begin(), v.end());
   }
+  // The largest magnitude over channels (weights may be negative).
+  constexpr double max_abs() const {
+    double m = 0;
+    for (double x : v) m = std::max(m, x < 0 ? -x : x);
+    return m;
+  }
   constexpr double sum() const {
     double s = 0;
     for (double x : v) s += x;

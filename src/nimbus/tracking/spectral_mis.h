@@ -16,8 +16,8 @@
 //   T_maj/pdf)
 //            with pdf = T_maj[h] mu_maj[h]
 // with b = mu_maj / max(mu_maj, mu_t). The hero's events are drawn with P_* = mu_*[h] b[h] /
-// mu_maj[h], P_n = 1 − P_a − P_s: where the
-// majorant bounds, P_a = mu_a/mu_maj, P_s = mu_s/mu_maj, P_n = mu_n/mu_maj; where it does not
+// mu_maj[h], P_n = 1 − P_a − P_s: where the majorant bounds, P_a = mu_a/mu_maj,
+// P_s = mu_s/mu_maj, P_n = mu_n/mu_maj; where it does not
 // (mu_n = mu_maj − mu_t < 0), P_n = 0 and absorption and scattering share 1. Each channel's r_u
 // uses that channel's own probabilities (its technique cannot sample a null event where its
 // majorant fails), while beta carries the signed mu_n. So the estimate stays unbiased as long as
@@ -136,7 +136,7 @@ bool hero_ratio_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N
         path.r_l *= T_maj * mu_maj / pdf;
         path.r_u *= T_maj * clamp_zero(mu_n) / pdf;
         const Spectrum<N> T = path.beta / (path.r_u + path.r_l).average();
-        if (std::max(T.max(), -T.min()) < 0.05) {  // |T|: a majorant that fails makes it signed
+        if (T.max_abs() < 0.05) {  // |T|: a majorant that fails makes it signed
           if (rng.uniform() < 0.75)
             path.beta = Spectrum<N>(0.0);
           else

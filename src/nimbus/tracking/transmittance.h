@@ -29,8 +29,7 @@ inline constexpr double kRouletteThreshold = 0.1;
 // instead of walking to its end. Returns false when T was set to 0.
 template <int N>
 bool transmittance_roulette(Spectrum<N>& T, Rng& rng) {
-  double m = 0;
-  for (int i = 0; i < N; ++i) m = std::max(m, std::abs(T[i]));
+  const double m = T.max_abs();
   if (m >= kRouletteThreshold) return true;
   const double q = m / kRouletteThreshold;
   if (rng.uniform() < q) {
