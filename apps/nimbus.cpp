@@ -79,6 +79,42 @@ void print_progress(double fraction, double elapsed) {
   std::fflush(stderr);
 }
 
+// Refuses, with one line and exit 2, a render that the machine (or --max-memory) cannot hold,
+// before anything large is allocated (render/memory_estimate.h); 0 if it fits.
+int check_memory(const nimbus::SceneDesc& desc, const RenderArgs& args) {
+  using namespace nimbus;
+  int octrees = 1;
+  for (const ObjectDesc& o : desc.objects)
+    octrees += o.medium >= 0 && o.surface.type == SurfaceDesc::Type::Dielectric;
+  const int bins = desc.spectrum.mode == SpectralSettings::Mode::Spectral ? kSpectralBins : 3;
+  const int threads = args.threads > 0 ? args.threads : int(std::thread::hardware_concurrency());
+  const MemoryEstimate need =
+      estimate_render_memory(desc.film.width, desc.film.height, octrees, bins, threads);
+  std::uint64_t limit = 0;
+  std::string source = "available";
+  try {
+    if (!args.max_memory.empty()) {
+      limit = parse_memory_size(args.max_memory);
+      source = "allowed by --max-memory";
+    } else {
+      limit = available_memory();
+    }
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "nimbus: --max-memory: %s\n", e.what());
+    return kExitBadInput;
+  }
+  if (limit > 0 && need.total() > double(limit)) {
+    std::fprintf(stderr,
+                 "nimbus: the render needs about %s (film %s, image %s, majorant octrees %s), "
+                 "more than the %s %s\n",
+                 format_memory(need.total()).c_str(), format_memory(need.film).c_str(),
+                 format_memory(need.image).c_str(), format_memory(need.octrees).c_str(),
+                 format_memory(double(limit)).c_str(), source.c_str());
+    return kExitBadInput;
+  }
+  return 0;
+}
+
 int run_render(const RenderArgs& args) {
   using namespace nimbus;
   std::vector<std::string> overrides = args.sets;
@@ -106,38 +142,7 @@ int run_render(const RenderArgs& args) {
     return kExitBadInput;
   }
 
-  // Refuse what the machine cannot hold before allocating it (render/memory_estimate.h).
-  {
-    int octrees = 1;
-    for (const ObjectDesc& o : desc.objects)
-      octrees += o.medium >= 0 && o.surface.type == SurfaceDesc::Type::Dielectric;
-    const int bins = desc.spectrum.mode == SpectralSettings::Mode::Spectral ? kSpectralBins : 3;
-    const int threads = args.threads > 0 ? args.threads : int(std::thread::hardware_concurrency());
-    const MemoryEstimate need =
-        estimate_render_memory(desc.film.width, desc.film.height, octrees, bins, threads);
-    std::uint64_t limit = 0;
-    std::string source = "available";
-    try {
-      if (!args.max_memory.empty()) {
-        limit = parse_memory_size(args.max_memory);
-        source = "allowed by --max-memory";
-      } else {
-        limit = available_memory();
-      }
-    } catch (const std::invalid_argument& e) {
-      std::fprintf(stderr, "nimbus: --max-memory: %s\n", e.what());
-      return kExitBadInput;
-    }
-    if (limit > 0 && need.total() > double(limit)) {
-      std::fprintf(stderr,
-                   "nimbus: the render needs about %s (film %s, image %s, majorant octrees %s), "
-                   "more than the %s %s\n",
-                   format_memory(need.total()).c_str(), format_memory(need.film).c_str(),
-                   format_memory(need.image).c_str(), format_memory(need.octrees).c_str(),
-                   format_memory(double(limit)).c_str(), source.c_str());
-      return kExitBadInput;
-    }
-  }
+  if (const int refused = check_memory(desc, args); refused != 0) return refused;
 
   Scene scene;
   try {
@@ -297,7 +302,7 @@ int run_experiment(const ExperimentArgs& args) {
 
 // An integer option's check that says its range in words: "--spp must be >= 1, not 0". (CLI11's
 // own range checks print the double bounds of the option's type.)
-CLI::Validator integer_at_least(long long lo, long long hi = std::numeric_limits<int>::max()) {
+CLI::Validator integer_in(long long lo, long long hi = std::numeric_limits<int>::max()) {
   return CLI::Validator(
       [lo, hi](std::string& value) -> std::string {
         long long x = 0;
@@ -328,11 +333,11 @@ int main(int argc, char** argv) {
                      "Output image; repeatable; .exr (linear float) or .png (8-bit sRGB). "
                      "Default: <scene stem>.exr and .png in the current directory");
   render->add_option("--spp", args.spp, "Samples per pixel (overrides integrator.spp)")
-      ->check(integer_at_least(1));
+      ->check(integer_in(1));
   render->add_option("--seed", args.seed, "Random seed (overrides integrator.seed)")
-      ->check(integer_at_least(0, std::numeric_limits<long long>::max()));
+      ->check(integer_in(0, std::numeric_limits<long long>::max()));
   render->add_option("--threads", args.threads, "Worker threads (default: all cores)")
-      ->check(integer_at_least(1, 4096));
+      ->check(integer_in(1, 4096));
   render->add_option("--set", args.sets,
                      "Override a scene key: --set integrator.spp=16 (dotted path, JSON value); "
                      "repeatable");
@@ -353,9 +358,9 @@ int main(int argc, char** argv) {
       ->required();
   experiment->add_flag("--quick", exp.quick, "A tiny variant that runs in seconds");
   experiment->add_option("--seed", exp.seed, "Random seed")
-      ->check(integer_at_least(0, std::numeric_limits<long long>::max()));
+      ->check(integer_in(0, std::numeric_limits<long long>::max()));
   experiment->add_option("--threads", exp.threads, "Worker threads (default: all cores)")
-      ->check(integer_at_least(1, 4096));
+      ->check(integer_in(1, 4096));
   experiment->add_option("--scenes", exp.scenes, "Directory of the scene files")
       ->capture_default_str();
   experiment->add_flag("--no-plot", exp.no_plot, "Write the CSV files only");
