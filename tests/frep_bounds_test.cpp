@@ -14,9 +14,10 @@ using test::leaf;
 TEST(Bounds, EllipsoidsAreExact) {
   const Tape s = compile(*leaf(sphere({0.5, -1, 2}, 1.5)));
   ASSERT_TRUE(s.bounds.bounded);
+  const Vec3 center{0.5, -1, 2};
   for (int i = 0; i < 3; ++i) {
-    EXPECT_NEAR(s.bounds.box.lo[i], Vec3(0.5, -1, 2)[i] - 1.5, 1e-9);
-    EXPECT_NEAR(s.bounds.box.hi[i], Vec3(0.5, -1, 2)[i] + 1.5, 1e-9);
+    EXPECT_NEAR(s.bounds.box.lo[i], center[i] - 1.5, 1e-9);
+    EXPECT_NEAR(s.bounds.box.hi[i], center[i] + 1.5, 1e-9);
   }
   // A rotated, translated ellipsoid: half-width along axis i is sqrt(Σ_j (R_ij r_j)²).
   const Vec3 radii{1.2, 0.3, 0.7}, centre{1, 2, 3};

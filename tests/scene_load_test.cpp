@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -384,6 +385,44 @@ TEST(SceneLoad, MalformedScenesGiveOneLineErrorsNamingThePath) {
     const std::string message = load_error(c.text, c.overrides);
     EXPECT_EQ(message, c.message) << c.what;
     EXPECT_EQ(message.find('\n'), std::string::npos) << c.what;
+  }
+}
+
+// The fuzzer's seed corpus (fuzz/corpus, docs/testing.md) holds every bad scene above and every
+// shipped scene, each in a file named after its text's FNV-1a hash. Run this test with
+// NIMBUS_WRITE_FUZZ_CORPUS=1 to write the missing ones.
+std::string corpus_name(const std::string& text) {
+  uint64_t h = 1469598103934665603ull;
+  for (const unsigned char c : text) h = (h ^ c) * 1099511628211ull;
+  return fmt::format("{:016x}.json", h);
+}
+
+TEST(SceneLoad, FuzzCorpusHoldsEveryBadAndShippedScene) {
+  std::vector<std::string> texts;
+  for (const BadScene& c : bad_scenes())
+    if (c.overrides.empty()) texts.push_back(c.text);
+  for (const char* dir : {"scenes", "scenes/bench"})
+    for (const auto& entry :
+         std::filesystem::directory_iterator(std::string(NIMBUS_SOURCE_DIR) + "/" + dir))
+      if (entry.path().extension() == ".json") {
+        std::ifstream in(entry.path(), std::ios::binary);
+        std::stringstream text;
+        text << in.rdbuf();
+        texts.push_back(text.str());
+      }
+  EXPECT_GE(texts.size(), 40u);
+  const std::string corpus = std::string(NIMBUS_SOURCE_DIR) + "/fuzz/corpus/";
+  const bool write = std::getenv("NIMBUS_WRITE_FUZZ_CORPUS") != nullptr;
+  for (const std::string& text : texts) {
+    const std::string path = corpus + corpus_name(text);
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream held;
+    held << in.rdbuf();
+    if (write && held.str() != text) {
+      std::ofstream(path, std::ios::binary) << text;
+      continue;
+    }
+    EXPECT_EQ(held.str(), text) << path << " (NIMBUS_WRITE_FUZZ_CORPUS=1 writes it)";
   }
 }
 

@@ -2,7 +2,7 @@
 # Installs the Debian packages nimbus needs. A no-op when they are present.
 set -euo pipefail
 packages=(
-  build-essential cmake pkg-config
+  build-essential cmake pkg-config clang libclang-rt-14-dev
   libtbb-dev libopenexr-dev libpng-dev nlohmann-json3-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   colord-data python3-numpy python3-matplotlib

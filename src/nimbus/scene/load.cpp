@@ -676,20 +676,24 @@ class DuplicateKeys {
   std::vector<Frame> frames_;
 };
 
-SceneDesc load_scene_file(const std::string& path, const std::vector<std::string>& overrides) {
+SceneDesc load_scene_text(const std::string& text, const std::string& source,
+                          const std::vector<std::string>& overrides) {
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(read_file(path), DuplicateKeys(path), true,
-                              /*ignore_comments=*/true);
+    j = nlohmann::json::parse(text, DuplicateKeys(source), true, /*ignore_comments=*/true);
   } catch (const nlohmann::json::exception& e) {
     // what() is "[json.exception.parse_error.101] parse error at line 3, column 5: ..." (or an
     // out_of_range error for numbers beyond double).
     std::string what = e.what();
     const size_t bracket = what.find("] ");
-    throw SceneError(path + ": " +
+    throw SceneError(source + ": " +
                      (bracket == std::string::npos ? what : what.substr(bracket + 2)));
   }
-  return load_scene_json(std::move(j), path, overrides);
+  return load_scene_json(std::move(j), source, overrides);
+}
+
+SceneDesc load_scene_file(const std::string& path, const std::vector<std::string>& overrides) {
+  return load_scene_text(read_file(path), path, overrides);
 }
 
 }  // namespace nimbus

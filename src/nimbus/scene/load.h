@@ -25,7 +25,12 @@ inline constexpr std::uintmax_t kMaxSceneFileBytes = std::uintmax_t{64} << 20;
 // file and, inside it, the JSON path.
 SceneDesc load_scene_file(const std::string& path, const std::vector<std::string>& overrides = {});
 
-// As load_scene_file for a document already in memory; `source` names it in messages.
+// As load_scene_file for a scene file's text already in memory (the fuzzer's entry point);
+// `source` names it in messages.
+SceneDesc load_scene_text(const std::string& text, const std::string& source,
+                          const std::vector<std::string>& overrides = {});
+
+// As load_scene_file for a document already parsed; `source` names it in messages.
 SceneDesc load_scene_json(nlohmann::json j, const std::string& source,
                           const std::vector<std::string>& overrides = {});
 
