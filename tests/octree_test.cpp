@@ -61,7 +61,7 @@ Scene three_media(int depth) {
 Rgb mu_t_at(const Scene& scene, const Vec3& p) {
   PathSpectra<3> ps;
   prepare_path_spectra(ps, scene, 0.0);
-  return medium_at(scene, ps, p, -1).mu_t();
+  return medium_at(scene, ps.media, p, -1).mu_t();
 }
 
 // A node's majorant and minorant in rgb mode.
@@ -146,7 +146,7 @@ TEST(Octree, SpectralBinsBoundMuTAtTheSampledWavelengths) {
   for (int i = 0; i < 4000; ++i) {
     prepare_path_spectra(ps, scene, rng.uniform());
     const Vec3 p = point_in(tree.box, rng);
-    const Spectrum<8> mu = medium_at(scene, ps, p, -1).mu_t();
+    const Spectrum<8> mu = medium_at(scene, ps.media, p, -1).mu_t();
     inside_medium += mu.max() > 0;
     descend(tree, p, [&](int index, int level) {
       if (tree.nodes[index].empty) {
@@ -426,6 +426,7 @@ TEST(Octree, MajorantScaleMultipliesTheWalkedMajorants) {
   const Ray ray{{-3, 0.1, 0.05}, normalize(Vec3{1, 0.02, 0.01})};
   const Walked plain = walk(scene, ray, 0, 10);
   scene.settings.tracking.majorant_scale = 0.5;
+  build_majorant_octrees(scene);  // the scale is the octree's, applied by its walk
   const Walked half = walk(scene, ray, 0, 10);
   ASSERT_EQ(plain.segments.size(), half.segments.size());
   ASSERT_FALSE(plain.segments.empty());

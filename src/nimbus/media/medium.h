@@ -5,6 +5,7 @@
 #include "nimbus/media/constant_density.h"
 #include "nimbus/media/density.h"
 #include "nimbus/spectral/spectral_param.h"
+#include "nimbus/spectral/spectrum.h"
 
 namespace nimbus {
 
@@ -14,6 +15,12 @@ struct Medium {
   double g = 0;                    // Henyey–Greenstein asymmetry; 0 is isotropic
   DensityPtr density = make_constant_density();
   double scale = 1;  // multiplies the density
+};
+
+// A medium's coefficients at a path's N channels (spectral/channels.h), before the density.
+template <int N>
+struct MediumCoefficients {
+  Spectrum<N> sigma_a, sigma_s, emission;
 };
 
 }  // namespace nimbus

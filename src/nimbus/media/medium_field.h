@@ -2,18 +2,19 @@
 // The medium as a field (DESIGN.md): wherever an index-matched object's function is positive its
 // medium is present, and overlapping media add. Inside a solid object (a dielectric with a
 // medium) only that object's medium is present: a solid displaces the media around it.
-// Everything here works on a path's N channels (render/path_spectra.h).
+// Everything here works on a path's N channels (spectral/channels.h) and on any scene that has
+// what the media layer needs (media_scene.h).
 
 #include <array>
 #include <utility>
 #include <vector>
 
 #include "nimbus/math/ray.h"
+#include "nimbus/media/media_scene.h"
 #include "nimbus/media/medium.h"
 #include "nimbus/media/octree.h"
 #include "nimbus/media/phase.h"
-#include "nimbus/render/path_spectra.h"
-#include "nimbus/render/scene.h"
+#include "nimbus/spectral/channels.h"
 #include "nimbus/spectral/spectrum.h"
 
 namespace nimbus {
@@ -37,10 +38,10 @@ double medium_density(const Medium& medium, const Vec3& x, double F);
 
 // Calls f(medium index, density) for each medium present at x (at most kMaxMediaAtPoint), seen
 // from `inside`, the solid object the point is in (-1: none).
-template <class F>
-void for_each_medium_at(const Scene& scene, const Vec3& x, int inside, F&& f) {
+template <MediumHolders S, class F>
+void for_each_medium_at(const S& scene, const Vec3& x, int inside, F&& f) {
   if (inside >= 0) {
-    const SceneObject& obj = scene.objects[inside];
+    const auto& obj = scene.objects[inside];
     if (obj.medium < 0) return;
     const Medium& medium = scene.media[obj.medium];
     const double F_x = medium.density->uses_F() ? evaluate(obj.tape, x) : 1.0;
@@ -50,7 +51,7 @@ void for_each_medium_at(const Scene& scene, const Vec3& x, int inside, F&& f) {
   }
   int count = 0;
   for (int i : scene.field_objects) {
-    const SceneObject& obj = scene.objects[i];
+    const auto& obj = scene.objects[i];
     if (!obj.bounds.contains(x)) continue;
     const double F_x = evaluate(obj.tape, x);
     if (F_x <= 0) continue;
@@ -61,11 +62,14 @@ void for_each_medium_at(const Scene& scene, const Vec3& x, int inside, F&& f) {
   }
 }
 
-template <int N>
-MediumPoint<N> medium_at(const Scene& scene, const PathSpectra<N>& ps, const Vec3& x, int inside) {
+// The coefficients at x seen from `inside`, with each medium's coefficients at the path's
+// channels in `coefficients` (indexed as scene.media).
+template <int N, MediumHolders S>
+MediumPoint<N> medium_at(const S& scene, const std::vector<MediumCoefficients<N>>& coefficients,
+                         const Vec3& x, int inside) {
   MediumPoint<N> m;
   for_each_medium_at(scene, x, inside, [&](int medium, double density) {
-    const MediumCoefficients<N>& c = ps.media[medium];
+    const MediumCoefficients<N>& c = coefficients[medium];
     const Spectrum<N> mu_a = c.sigma_a * density, mu_s = c.sigma_s * density;
     m.mu_a += mu_a;
     m.mu_s += mu_s;
@@ -78,7 +82,7 @@ MediumPoint<N> medium_at(const Scene& scene, const PathSpectra<N>& ps, const Vec
 }
 
 // A stretch of a ray with a majorant mu_bar and a minorant mu_c of mu_t there, per channel.
-// mu_bar is multiplied by the scene's majorant scale, so it need not bound when that is < 1.
+// mu_bar is multiplied by the octree's majorant scale, so it need not bound when that is < 1.
 template <int N>
 struct MajorantSegment {
   double t0, t1;
@@ -91,13 +95,13 @@ struct MajorantSegment {
 // `inside` (-1: the field; else that solid object), each channel taking its bin's bounds. Where
 // no medium can be there is a gap; neighbouring leaves with identical bounds become one segment.
 // f returns false to stop the walk. The ray direction must be unit length.
-template <int N, class F>
-void walk_majorant_segments(const Scene& scene, const Channels<N>& ch, const Ray& ray, double t_min,
+template <int N, MediaScene S, class F>
+void walk_majorant_segments(const S& scene, const Channels<N>& ch, const Ray& ray, double t_min,
                             double t_max, int inside, F&& f) {
   if (inside >= 0 && scene.objects[inside].medium < 0) return;  // a solid without a medium
   // at(): a scene whose octrees were never built fails loudly rather than reading past the end.
   const MajorantOctree& tree = inside >= 0 ? scene.solid_octrees.at(inside) : scene.field_octree;
-  const double scale = scene.settings.tracking.majorant_scale;
+  const double scale = tree.majorant_scale;
   MajorantSegment<N> pending{0, 0, Spectrum<N>(0.0), Spectrum<N>(0.0)};
   bool has_pending = false;
   const bool finished =

@@ -7,8 +7,7 @@
 
 #include "nimbus/math/rng.h"
 #include "nimbus/media/medium_field.h"
-#include "nimbus/render/path_spectra.h"
-#include "nimbus/render/scene.h"
+#include "nimbus/spectral/channels.h"
 #include "nimbus/spectral/wavelengths.h"
 
 namespace nimbus {
@@ -16,7 +15,7 @@ namespace {
 
 // An object whose medium the tree covers, with its medium's sigma_t bounds per bin.
 struct Member {
-  const SceneObject* object;
+  const OctreeMember* object;
   const Medium* medium;
   const double* sigma_t_hi;
   const double* sigma_t_lo;
@@ -24,10 +23,10 @@ struct Member {
 
 // sigma_t = sigma_a + sigma_s of every medium per bin: in rgb mode the channels' values; in
 // spectral mode bounds over each bin's wavelength interval (hi, then lo, `bins` each).
-std::vector<std::vector<double>> sigma_t_bins(const Scene& scene, int bins) {
+std::vector<std::vector<double>> sigma_t_bins(std::span<const Medium> media, bool spectral,
+                                              int bins) {
   std::vector<std::vector<double>> out;
-  const bool spectral = scene.settings.spectral.mode == SpectralSettings::Mode::Spectral;
-  for (const Medium& m : scene.media) {
+  for (const Medium& m : media) {
     std::vector<double> v(2 * bins);
     for (int b = 0; b < bins; ++b) {
       if (!spectral) {
@@ -52,7 +51,7 @@ std::vector<std::vector<double>> sigma_t_bins(const Scene& scene, int bins) {
 bool density_range(const Member& m, const Box& box, bool solid, double& lo, double& hi) {
   const Box b = intersect(m.object->bounds, box);
   if (b.empty()) return false;  // medium_at only looks at objects whose bounds hold the point
-  const Interval F = evaluate(m.object->tape, b);
+  const Interval F = evaluate(*m.object->tape, b);
   if (!(F.hi > 0)) return false;
   const Medium& med = *m.medium;
   const Interval r = med.density->range(b, F);
@@ -200,18 +199,31 @@ void floor_sampled_bounds(double lo, double hi, double& mu_bar, double& mu_c) {
 // The paper's preliminary pass: min and max of mu_t at random points of each non-empty leaf,
 // per bin (in spectral mode from each medium's sigma_t bounds over the bin). Interior nodes then
 // hold the hull of their children.
-void sample_bounds(const Scene& scene, int inside, const std::vector<std::vector<double>>& sigma_t,
-                   MajorantOctree& tree, Grown& g) {
+// The members as the media layer's point lookup wants them (media_scene.h).
+struct MemberObject {
+  const Tape& tape;
+  const Box& bounds;
+  int medium;
+};
+struct MemberScene {
+  std::span<const Medium> media;
+  std::vector<MemberObject> objects;
+  std::vector<int> field_objects;
+};
+
+void sample_bounds(const MemberScene& scene, int inside, const OctreeSettings& settings,
+                   const std::vector<std::vector<double>>& sigma_t, MajorantOctree& tree,
+                   Grown& g) {
   // At most kOctreeSampleBudget points in all: a deep tree gets fewer per leaf (at depth 16 with
   // 4 096 per leaf the pass had not finished after 60 s).
   size_t leaves = 0;
   for (const OctreeNode& n : g.nodes) leaves += n.children < 0 && !n.empty;
   const size_t affordable = std::max<size_t>(1, kOctreeSampleBudget / std::max<size_t>(leaves, 1));
   const int samples = static_cast<int>(
-      std::min<size_t>(affordable, size_t(std::max(1, scene.settings.tracking.majorant_samples))));
+      std::min<size_t>(affordable, size_t(std::max(1, settings.samples_per_leaf))));
   tree.sampled_points = uint64_t(samples) * leaves;
   const int bins = tree.bins;
-  const uint64_t seed = splitmix64(scene.settings.seed ^ 0x6f637472656573ull);
+  const uint64_t seed = splitmix64(settings.seed ^ 0x6f637472656573ull);
   tbb::parallel_for(size_t{0}, g.nodes.size(), [&](size_t i) {
     const OctreeNode& n = g.nodes[i];
     if (n.children >= 0 || n.empty) return;
@@ -262,27 +274,22 @@ void sample_bounds(const Scene& scene, int inside, const std::vector<std::vector
 
 }  // namespace
 
-MajorantOctree build_majorant_octree(const Scene& scene, int inside) {
+MajorantOctree build_majorant_octree(std::span<const Medium> media,
+                                     std::span<const OctreeMember> holders, bool solid,
+                                     const OctreeSettings& settings) {
   const auto start = std::chrono::steady_clock::now();
-  const TrackingSettings& settings = scene.settings.tracking;
   MajorantOctree tree;
-  tree.bins = scene.settings.spectral.mode == SpectralSettings::Mode::Spectral ? kSpectralBins : 3;
+  tree.bins = settings.spectral ? kSpectralBins : 3;
+  tree.majorant_scale = settings.majorant_scale;
   const int bins = tree.bins;
-  const std::vector<std::vector<double>> sigma_t = sigma_t_bins(scene, bins);
-  auto member = [&](const SceneObject& obj) {
-    const std::vector<double>& s = sigma_t[obj.medium];
-    return Member{&obj, &scene.media[obj.medium], s.data(), s.data() + bins};
-  };
+  const std::vector<std::vector<double>> sigma_t = sigma_t_bins(media, settings.spectral, bins);
   std::vector<Member> members;
-  if (inside >= 0) {
-    const SceneObject& obj = scene.objects[inside];
-    if (obj.medium >= 0) members.push_back(member(obj));
-  } else {
-    for (int i : scene.field_objects) members.push_back(member(scene.objects[i]));
+  for (const OctreeMember& h : holders) {
+    const std::vector<double>& s = sigma_t[h.medium];
+    members.push_back(Member{&h, &media[h.medium], s.data(), s.data() + bins});
   }
   for (const Member& m : members) tree.box = unite(tree.box, m.object->bounds);
   if (tree.box.empty()) return tree;
-  const bool solid = inside >= 0;
   tree.half[0] = tree.box.extent() * 0.5;
   for (int l = 1; l <= kOctreeMaxDepth; ++l) tree.half[l] = tree.half[l - 1] * 0.5;
 
@@ -297,7 +304,7 @@ MajorantOctree build_majorant_octree(const Scene& scene, int inside) {
   g.nodes.push_back(make_node(tree.box.center(), tree.half[0], g.bounds.data()));
   g.centers.push_back(tree.box.center());
   g.levels.push_back(0);
-  const int max_depth = std::clamp(settings.octree_depth, 0, kOctreeMaxDepth);
+  const int max_depth = std::clamp(settings.depth, 0, kOctreeMaxDepth);
   size_t begin = 0, end = 1;
   for (int level = 0; level < max_depth; ++level) {
     const Vec3& half = tree.half[level];
@@ -342,23 +349,19 @@ MajorantOctree build_majorant_octree(const Scene& scene, int inside) {
   }
   g = prune(std::move(g), tree);
   tree.depth = *std::max_element(g.levels.begin(), g.levels.end());
-  if (settings.majorant_source == TrackingSettings::MajorantSource::Sample)
-    sample_bounds(scene, inside, sigma_t, tree, g);
+  if (settings.sampled) {
+    MemberScene scene{media, {}, {}};
+    for (size_t i = 0; i < holders.size(); ++i) {
+      scene.objects.push_back({*holders[i].tape, holders[i].bounds, holders[i].medium});
+      if (!solid) scene.field_objects.push_back(static_cast<int>(i));
+    }
+    sample_bounds(scene, solid ? 0 : -1, settings, sigma_t, tree, g);
+  }
   tree.nodes = std::move(g.nodes);
   tree.bounds = std::move(g.bounds);
   tree.build_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return tree;
-}
-
-void build_majorant_octrees(Scene& scene) {
-  scene.field_octree = build_majorant_octree(scene, -1);
-  scene.solid_octrees.assign(scene.objects.size(), MajorantOctree{});
-  for (size_t i = 0; i < scene.objects.size(); ++i) {
-    const SceneObject& obj = scene.objects[i];
-    if (obj.medium >= 0 && obj.surface.type != Surface::Type::None)
-      scene.solid_octrees[i] = build_majorant_octree(scene, static_cast<int>(i));
-  }
 }
 
 }  // namespace nimbus

@@ -27,16 +27,17 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <utility>
 #include <vector>
 
+#include "nimbus/frep/tape.h"
 #include "nimbus/math/box.h"
 #include "nimbus/math/ray.h"
+#include "nimbus/media/medium.h"
 #include "nimbus/spectral/spectrum.h"
 
 namespace nimbus {
-
-struct Scene;
 
 inline constexpr int kOctreeMaxDepth = 16;
 inline constexpr double kOctreeHomogeneous = 0.02;
@@ -59,7 +60,7 @@ struct OctreeNode {
 };
 
 // Bounds are kept per bin: in rgb mode the three channels; in spectral mode kSpectralBins
-// wavelength intervals (render/path_spectra.h), each bounding mu_t over its whole interval, so
+// wavelength intervals (spectral/channels.h), each bounding mu_t over its whole interval, so
 // any wavelength drawn in it is bounded.
 struct MajorantOctree {
   Box box;  // the root's box; empty when there is no medium
@@ -68,8 +69,8 @@ struct MajorantOctree {
   std::array<Vec3, kOctreeMaxDepth + 1> half{};
   std::vector<OctreeNode> nodes;  // breadth first, nodes[0] the root; empty when no medium
   int bins = 3;
-  // Per node, `bins` majorants of mu_t (the majorant scale is applied by the walk), then `bins`
-  // minorants.
+  double majorant_scale = 1;  // OctreeSettings::majorant_scale, applied by the walk
+  // Per node, `bins` majorants of mu_t (unscaled), then `bins` minorants.
   std::vector<double> bounds;
   int depth = 0;  // deepest level reached
   double build_seconds = 0;
@@ -83,14 +84,29 @@ struct MajorantOctree {
   }
 };
 
-// The octree of the media a ray sees from `inside`: -1 for the field of index-matched objects,
-// else the index of a solid object holding a medium (only its medium, over its bounds). Uses
-// scene.settings.tracking (octree_depth, majorant_source, majorant_samples) and seed.
-MajorantOctree build_majorant_octree(const Scene& scene, int inside);
+struct OctreeSettings {
+  int depth = 4;                // 0: one global node (the baseline)
+  bool sampled = false;         // bounds from the paper's sampling pass, else interval bounds
+  int samples_per_leaf = 4096;  // points per leaf for the sampling pass (within a total budget)
+  double majorant_scale = 1;    // multiplies every majorant at the walk (< 1: not bounding)
+  uint64_t seed = 0;            // the sampling pass's random numbers
+  bool spectral = false;        // kSpectralBins wavelength bins, else the 3 rgb channels
+};
 
-// (Re)builds every octree of the scene: the field's and one per solid object with a medium.
-// Call after the objects, media and tracking settings are final.
-void build_majorant_octrees(Scene& scene);
+// An object whose medium a tree covers: its function, conservative bounds and medium (an index
+// into the media given with it). The tape must outlive the build only.
+struct OctreeMember {
+  const Tape* tape;
+  Box bounds;
+  int medium;
+};
+
+// The octree over `members`' media: inside one solid object (`solid`: one member, whose medium
+// fills it) or over the field of index-matched objects (each medium present where its
+// object's F > 0, overlapping media adding up).
+MajorantOctree build_majorant_octree(std::span<const Medium> media,
+                                     std::span<const OctreeMember> members, bool solid,
+                                     const OctreeSettings& settings);
 
 // Calls leaf(node index, a, b) for every non-empty leaf the ray crosses in [t_min, t_max], front to
 // back, with [a, b] the ray's stretch inside it; consecutive stretches share their end points

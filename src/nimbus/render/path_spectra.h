@@ -1,14 +1,16 @@
 #pragma once
-// What a path's N channels are (docs/spectra.md): in rgb mode the three RGB channels; in spectral
-// mode N wavelengths drawn for the path. Each path evaluates the media's coefficients and the
-// lights' emission at its channels once, so the tracking estimators see plain Spectrum<N> values
-// either way and run unchanged; the film turns a path's channels into linear sRGB.
+// A path's spectra (docs/spectra.md): its N channels (spectral/channels.h) and, at them, the
+// media's coefficients and the lights' emission, evaluated once per path, so the tracking
+// estimators see plain Spectrum<N> values in either mode and run unchanged; the film turns a
+// path's channels into linear sRGB.
 
 #include <algorithm>
 #include <array>
 #include <vector>
 
+#include "nimbus/media/medium.h"
 #include "nimbus/render/scene.h"
+#include "nimbus/spectral/channels.h"
 #include "nimbus/spectral/cie.h"
 #include "nimbus/spectral/color.h"
 #include "nimbus/spectral/spectral_param.h"
@@ -18,38 +20,11 @@
 namespace nimbus {
 
 template <int N>
-struct Channels {
-  bool spectral = false;
-  SampledWavelengths<N> wl;  // spectral mode
-  std::array<int, N> bin{};  // the majorant octree's bin holding each channel
-};
-
-// A colour input at the path's channels.
-template <int N>
-Spectrum<N> evaluate(const SpectralParam& p, const Channels<N>& ch) {
-  Spectrum<N> s;
-  if constexpr (N == 3) {
-    if (!ch.spectral) return p.rgb;
-  }
-  for (int i = 0; i < N; ++i) s[i] = (*p.curve)(ch.wl.lambda[i]);
-  return s;
-}
-
-template <int N>
-struct MediumCoefficients {
-  Spectrum<N> sigma_a, sigma_s, emission;
-};
-
-template <int N>
 struct PathSpectra {
   Channels<N> ch;
   std::vector<MediumCoefficients<N>> media;  // indexed as scene.media
   std::vector<Spectrum<N>> lights;           // each light's emission, indexed as scene.lights
 };
-
-// The octree's bins in spectral mode: kSpectralBins intervals of equal probability under the
-// wavelength pdf, so a channel drawn from stratified number u lies in bin ⌊u · kSpectralBins⌋.
-inline constexpr int kSpectralBins = 16;
 
 // Sets up ps for a path of `scene`: in rgb mode the RGB channels (u unused); in spectral mode
 // N wavelengths from the uniform number u. Reuses ps's storage.

@@ -52,6 +52,37 @@ Vec3 offset_origin(const Scene& scene, const Vec3& p, const Vec3& n, const Vec3&
   return dot(n, w) >= 0 ? p + n * eps : p - n * eps;
 }
 
+OctreeSettings octree_settings(const RenderSettings& settings) {
+  const TrackingSettings& t = settings.tracking;
+  return {t.octree_depth,     t.majorant_source == TrackingSettings::MajorantSource::Sample,
+          t.majorant_samples, t.majorant_scale,
+          settings.seed,      settings.spectral.mode == SpectralSettings::Mode::Spectral};
+}
+
+MajorantOctree build_majorant_octree(const Scene& scene, int inside) {
+  std::vector<OctreeMember> members;
+  auto add = [&](int i) {
+    const SceneObject& obj = scene.objects[i];
+    if (obj.medium >= 0) members.push_back({&obj.tape, obj.bounds, obj.medium});
+  };
+  if (inside >= 0) {
+    add(inside);
+  } else {
+    for (int i : scene.field_objects) add(i);
+  }
+  return build_majorant_octree(scene.media, members, inside >= 0, octree_settings(scene.settings));
+}
+
+void build_majorant_octrees(Scene& scene) {
+  scene.field_octree = build_majorant_octree(scene, -1);
+  scene.solid_octrees.assign(scene.objects.size(), MajorantOctree{});
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const SceneObject& obj = scene.objects[i];
+    if (obj.medium >= 0 && obj.surface.type != Surface::Type::None)
+      scene.solid_octrees[i] = build_majorant_octree(scene, static_cast<int>(i));
+  }
+}
+
 void complete_spectra(Scene& scene) {
   for (Medium& m : scene.media) {
     complete_spectrum(m.sigma_a, SpectralRole::Unbounded);

@@ -90,6 +90,17 @@ bool occluded(const Scene& scene, const Ray& ray, double t_max, int target_light
 // mode needs them, rgb mode ignores them. Call before build_majorant_octrees.
 void complete_spectra(Scene& scene);
 
+// The octree settings a scene's render settings ask for.
+OctreeSettings octree_settings(const RenderSettings& settings);
+
+// The octree of the media a ray sees from `inside`: -1 for the field of index-matched objects,
+// else the index of a solid object holding a medium (only its medium, over its bounds).
+MajorantOctree build_majorant_octree(const Scene& scene, int inside);
+
+// (Re)builds every octree of the scene: the field's, and one per solid object with a medium.
+// Call after the objects, media and tracking settings are final.
+void build_majorant_octrees(Scene& scene);
+
 // The outward unit normal of an object at a point on its surface (F decreases outwards).
 Vec3 outward_normal(const SceneObject& object, const Vec3& p);
 

@@ -47,7 +47,7 @@ struct RayLookup {
   int inside;
   MediumPoint<N> last;
   MediumSample<N> operator()(double t) {
-    last = medium_at(scene, ps, ray.at(t), inside);
+    last = medium_at(scene, ps.media, ray.at(t), inside);
     return as_sample(last);
   }
 };
@@ -157,7 +157,7 @@ Spectrum<N> transmittance(const Scene& scene, const PathSpectra<N>& ps, const Ra
   ++counters.shadow_rays;
   if (occluded(scene, ray, t_max, light)) return Spectrum<N>(0.0);
   auto lookup = [&](double t) {
-    return volume_detail::as_sample(medium_at(scene, ps, ray.at(t), inside));
+    return volume_detail::as_sample(medium_at(scene, ps.media, ray.at(t), inside));
   };
   const bool residual =
       scene.settings.tracking.transmittance == TrackingSettings::Transmittance::ResidualRatio;
@@ -191,7 +191,7 @@ bool transmittance_mis(const Scene& scene, const PathSpectra<N>& ps, const Ray& 
   ++counters.shadow_rays;
   if (occluded(scene, ray, t_max, light)) return false;
   auto lookup = [&](double t) {
-    return volume_detail::as_sample(medium_at(scene, ps, ray.at(t), inside));
+    return volume_detail::as_sample(medium_at(scene, ps.media, ray.at(t), inside));
   };
   bool reaches = true;
   walk_majorant_segments(scene, ps.ch, ray, 0, t_max, inside, [&](const MajorantSegment<N>& seg) {
