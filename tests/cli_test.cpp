@@ -122,6 +122,12 @@ const BadCase kBad[] = {
     {"unbounded", "/objects/1/shape",
      "{\"type\": \"halfspace\", \"point\": [0, -1, 0], \"normal\": [0, -1, 0]}",
      "/objects/1/shape: shape \"inline\" is unbounded"},
+    // Found by the fuzzer: a coefficient so large that tracking's steps stopped advancing.
+    {"optical_thickness", "/media/fog/sigma_s", "1e7",
+     "/objects/2/medium: medium \"fog\" may reach an optical thickness of 1.73e+07"},
+    {"optical_thickness_spectral", "/media/fog/sigma_a",
+     "{\"spectrum\": [[400, 1], [520, 2.5e307], [700, 1]]}",
+     "/objects/2/medium: medium \"fog\" may reach an optical thickness of"},
 };
 
 TEST_F(Cli, MalformedScenesExitTwoWithOneLineAndNoOutput) {

@@ -8,6 +8,7 @@
 #include "nimbus/media/medium_field.h"
 #include "nimbus/media/octree.h"
 #include "nimbus/scene/load.h"
+#include "nimbus/spectral/wavelengths.h"
 
 namespace nimbus {
 namespace {
@@ -77,6 +78,22 @@ Medium compile_medium(const MediumDesc& d) {
   return m;
 }
 
+// An upper bound on the optical thickness of an object's medium across its bounds: the largest
+// sigma_t at any channel or wavelength, times the density's bound there, times the bounds'
+// diagonal. Tracking takes about this many steps along a ray through the object.
+double optical_thickness_bound(const Scene& scene, const SceneObject& obj) {
+  const Medium& m = scene.media[obj.medium];
+  const Interval density = m.density->range(obj.bounds, evaluate(obj.tape, obj.bounds));
+  double sigma_t = 0;
+  if (scene.settings.spectral.mode == SpectralSettings::Mode::Spectral) {
+    sigma_t = m.sigma_a.curve->range(kLambdaMin, kLambdaMax).second +
+              m.sigma_s.curve->range(kLambdaMin, kLambdaMax).second;
+  } else {
+    sigma_t = (m.sigma_a.rgb + m.sigma_s.rgb).max_abs();
+  }
+  return m.scale * density.hi * sigma_t * length(obj.bounds.extent());
+}
+
 }  // namespace
 
 Scene compile_scene(const SceneDesc& desc) {
@@ -93,6 +110,7 @@ Scene compile_scene(const SceneDesc& desc) {
   for (const MediumDesc& md : desc.media) scene.media.push_back(compile_medium(md));
 
   int field_objects = 0;  // finish_scene lists them; here they are counted for the message
+  std::vector<const ObjectDesc*> object_descs;  // of each compiled object, for messages
   for (const ObjectDesc& od : desc.objects) {
     SceneObject obj;
     obj.tape = compile(*od.shape);
@@ -117,9 +135,21 @@ Scene compile_scene(const SceneDesc& desc) {
                         desc.source, od.json_path, kMaxMediaAtPoint));
     }
     scene.objects.push_back(std::move(obj));
+    object_descs.push_back(&od);
   }
   for (const LightDesc& ld : desc.lights) scene.lights.push_back(compile_light(ld));
   finish_scene(scene);
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const SceneObject& obj = scene.objects[i];
+    if (obj.medium < 0) continue;
+    const double tau = optical_thickness_bound(scene, obj);
+    if (!(tau <= kMaxOpticalThickness))
+      throw SceneError(fmt::format(
+          "{}: {}/medium: medium \"{}\" may reach an optical thickness of {:.3g} across the "
+          "object; at most {:.0e} is supported (tracking takes about that many steps per ray)",
+          desc.source, object_descs[i]->json_path, desc.media[obj.medium].name, tau,
+          kMaxOpticalThickness));
+  }
   return scene;
 }
 

@@ -7,8 +7,14 @@
 
 namespace nimbus {
 
+// The largest optical thickness (an upper bound of sigma_t · density across an object's bounds)
+// that a scene file may give a medium. Tracking takes about that many steps along a ray, so a
+// larger one would look like a hang; realistic media stay far below (a 1 km cloud at 100 /m:
+// 10^5; skin at 40 /mm over 10 cm: 4 · 10^3).
+inline constexpr double kMaxOpticalThickness = 1e6;
+
 // Throws SceneError (one line, with the JSON path) for what only compilation can see, such as an
-// object whose shape is unbounded.
+// object whose shape is unbounded or a medium above kMaxOpticalThickness.
 Scene compile_scene(const SceneDesc& desc);
 
 // What a scene needs before it renders, derived from its objects, media, lights and settings:
