@@ -70,10 +70,11 @@ const char* signal_name(int sig) {
                           : "a signal";
 }
 
-void print_progress(double fraction, double elapsed) {
+// One line, redrawn: what is being done, a bar, the fraction, the time so far and the ETA.
+void print_progress(const char* what, double fraction, double elapsed) {
   const int width = 40, filled = static_cast<int>(fraction * width);
   const double eta = fraction > 0 ? elapsed * (1 - fraction) / fraction : 0;
-  std::fprintf(stderr, "\r[%s%s] %5.1f%%  %6.1fs elapsed  ETA %6.1fs",
+  std::fprintf(stderr, "\r%-8s [%s%s] %5.1f%%  %6.1fs elapsed  ETA %6.1fs", what,
                std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
                100 * fraction, elapsed, eta);
   std::fflush(stderr);
@@ -144,23 +145,43 @@ int run_render(const RenderArgs& args) {
 
   if (const int refused = check_memory(desc, args); refused != 0) return refused;
 
+  const bool show_progress = !args.quiet && isatty(fileno(stderr));
+  // The majorant octrees can take seconds to build (deep trees, sampled bounds): they get a
+  // bar of their own, and a signal stops them too.
+  BuildMonitor monitor;
+  monitor.cancel = [] { return g_signal.load() != 0; };
+  const auto build_start = std::chrono::steady_clock::now();
+  if (show_progress)
+    monitor.progress = [&](double f) {
+      print_progress(
+          "octrees", f,
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count());
+    };
   Scene scene;
   try {
-    scene = compile_scene(desc);
+    scene = compile_scene(desc, monitor);
   } catch (const SceneError& e) {
+    if (show_progress) std::fprintf(stderr, "\n");
     std::fprintf(stderr, "%s\n", e.what());
     return kExitBadInput;
+  }
+  if (show_progress) std::fprintf(stderr, "\n");
+  if (const int sig = g_signal.load(); sig != 0) {
+    std::fprintf(stderr,
+                 "nimbus: stopped by %s while building the majorant octrees; nothing written\n",
+                 signal_name(sig));
+    return 128 + sig;
   }
 
   RenderOptions options;
   options.threads = args.threads;
   options.cancel = [] { return g_signal.load() != 0; };
-  const bool show_progress = !args.quiet && isatty(fileno(stderr));
   const auto start = std::chrono::steady_clock::now();
   if (show_progress)
     options.progress = [&](double f) {
       print_progress(
-          f, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+          "render", f,
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     };
   const RenderResult result = render(scene, options);
   if (show_progress) std::fprintf(stderr, "\n");

@@ -300,6 +300,28 @@ TEST_F(Cli, SignalsStopTheRenderAndWriteNothing) {
   }
 }
 
+// Issue 16: a deep octree with sampled bounds builds for seconds; a signal stops that too.
+TEST_F(Cli, SignalsStopTheOctreeBuildAndWriteNothing) {
+  const std::string script =
+      std::string("cd '") + dir_.string() + "' && ('" + NIMBUS_BINARY + "' render '" +
+      NIMBUS_SOURCE_DIR +
+      "/scenes/cloud.json' --set integrator.octree.depth=16 --set "
+      "integrator.majorant.source=sample "
+      "-o out.png 2>err.txt & pid=$!; sleep 0.5; kill -INT $pid; wait $pid; echo $? > code.txt)";
+  ASSERT_EQ(std::system(script.c_str()), 0);
+  std::ifstream code_file(dir_ / "code.txt"), err_file(dir_ / "err.txt");
+  int exit_code = -1;
+  code_file >> exit_code;
+  EXPECT_EQ(exit_code, 130);
+  std::stringstream err;
+  err << err_file.rdbuf();
+  EXPECT_EQ(err.str(),
+            "nimbus: stopped by SIGINT while building the majorant octrees; nothing written\n");
+  fs::remove(dir_ / "code.txt");
+  fs::remove(dir_ / "err.txt");
+  EXPECT_TRUE(outputs().empty());
+}
+
 // Issue 16: a 16384 x 16384 film took 15.7 GB without a word. The render's memory is estimated
 // before anything large is allocated and refused past the available memory or --max-memory.
 TEST_F(Cli, RendersThatWouldNotFitAreRefusedUpFront) {

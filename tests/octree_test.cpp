@@ -1,7 +1,6 @@
+#include <algorithm>
 // The majorant octree (issue 6): conservative bounds at random points, the ray walk's segments,
 // empty nodes, determinism, the sampling source and the size limits.
-
-#include "nimbus/media/octree.h"
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
@@ -15,6 +14,7 @@
 #include "nimbus/media/cloud_density.h"
 #include "nimbus/media/field_density.h"
 #include "nimbus/media/medium_field.h"
+#include "nimbus/media/octree.h"
 #include "nimbus/render/path_spectra.h"
 #include "nimbus/render/scene.h"
 
@@ -347,6 +347,33 @@ TEST(Octree, SampledBoundsNeverHideMedium) {
       EXPECT_GT(floored, 0);
     }
   }
+}
+
+// Issue 16: a deep sampled build showed no progress. The monitor sees rising fractions that end
+// at 1, and a cancel stops the build before it produces a tree.
+TEST(Octree, BuildReportsProgressAndStopsWhenCancelled) {
+  Scene scene = three_media(5);
+  scene.settings.tracking.majorant_source = TrackingSettings::MajorantSource::Sample;
+  scene.settings.tracking.majorant_samples = 256;
+  std::vector<double> seen;
+  BuildMonitor watch;
+  watch.progress = [&](double f) { seen.push_back(f); };
+  const MajorantOctree tree = build_majorant_octree(scene, -1, watch);
+  ASSERT_FALSE(tree.nodes.empty());
+  ASSERT_GE(seen.size(), 6u);  // five levels, then leaves
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_EQ(seen.back(), 1.0);
+  EXPECT_GT(std::count_if(seen.begin(), seen.end(), [](double f) { return f > 0.5; }), 1);
+
+  int polls = 0;
+  BuildMonitor stop;
+  stop.cancel = [&] { return ++polls > 2; };
+  EXPECT_TRUE(build_majorant_octree(scene, -1, stop).nodes.empty());
+  EXPECT_GT(polls, 2);
+  // Without a cancel the same build completes: what stopped it was the monitor.
+  BuildMonitor never;
+  never.cancel = [] { return false; };
+  EXPECT_EQ(build_majorant_octree(scene, -1, never).nodes.size(), tree.nodes.size());
 }
 
 // Issue 16: at depth 16 with 4 096 samples per leaf the sampling pass had not finished after

@@ -3,7 +3,9 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <mutex>
 
 #include "nimbus/math/rng.h"
 #include "nimbus/media/medium_field.h"
@@ -199,6 +201,33 @@ void floor_sampled_bounds(double lo, double hi, double& mu_bar, double& mu_c) {
 // The paper's preliminary pass: min and max of mu_t at random points of each non-empty leaf,
 // per bin (in spectral mode from each medium's sigma_t bounds over the bin). Interior nodes then
 // hold the hull of their children.
+// Reports a build's progress from parallel workers: whichever thread gets the lock reports, the
+// others go on; cancellation is polled the same way.
+class Watch {
+ public:
+  explicit Watch(const BuildMonitor& m) : m_(m) {}
+  // Fractions that arrive out of order (a slower thread) are dropped, so the reports rise, and
+  // steps below 0.1 % are not worth a report (a deep tree has 10^5 leaves).
+  void report(double fraction) {
+    if (!m_.progress) return;
+    std::unique_lock lock(mutex_, std::try_to_lock);
+    if (!lock.owns_lock() || (fraction < 1 && fraction < last_ + 1e-3)) return;
+    last_ = fraction;
+    m_.progress(fraction);
+  }
+  bool cancelled() {
+    if (!cancelled_.load(std::memory_order_relaxed) && m_.cancel && m_.cancel())
+      cancelled_.store(true, std::memory_order_relaxed);
+    return cancelled_.load(std::memory_order_relaxed);
+  }
+
+ private:
+  const BuildMonitor& m_;
+  std::mutex mutex_;
+  double last_ = -1;
+  std::atomic<bool> cancelled_{false};
+};
+
 // The members as the media layer's point lookup wants them (media_scene.h).
 struct MemberObject {
   const Tape& tape;
@@ -211,9 +240,11 @@ struct MemberScene {
   std::vector<int> field_objects;
 };
 
+// Progress: the interval phase reports levels done as the first half, the sampling pass leaves
+// done as the second.
 void sample_bounds(const MemberScene& scene, int inside, const OctreeSettings& settings,
-                   const std::vector<std::vector<double>>& sigma_t, MajorantOctree& tree,
-                   Grown& g) {
+                   const std::vector<std::vector<double>>& sigma_t, MajorantOctree& tree, Grown& g,
+                   Watch& watch) {
   // At most kOctreeSampleBudget points in all: a deep tree gets fewer per leaf (at depth 16 with
   // 4 096 per leaf the pass had not finished after 60 s).
   size_t leaves = 0;
@@ -224,9 +255,11 @@ void sample_bounds(const MemberScene& scene, int inside, const OctreeSettings& s
   tree.sampled_points = uint64_t(samples) * leaves;
   const int bins = tree.bins;
   const uint64_t seed = splitmix64(settings.seed ^ 0x6f637472656573ull);
+  std::atomic<size_t> leaves_done{0};
   tbb::parallel_for(size_t{0}, g.nodes.size(), [&](size_t i) {
     const OctreeNode& n = g.nodes[i];
-    if (n.children >= 0 || n.empty) return;
+    if (n.children >= 0 || n.empty || watch.cancelled()) return;
+    watch.report(0.5 + 0.5 * double(leaves_done.fetch_add(1)) / double(leaves));
     const Box box = box_of(g.centers[i], tree.half[g.levels[i]]);
     Rng rng(seed, i);
     double* out = &g.bounds[2 * bins * i];
@@ -276,8 +309,9 @@ void sample_bounds(const MemberScene& scene, int inside, const OctreeSettings& s
 
 MajorantOctree build_majorant_octree(std::span<const Medium> media,
                                      std::span<const OctreeMember> holders, bool solid,
-                                     const OctreeSettings& settings) {
+                                     const OctreeSettings& settings, const BuildMonitor& monitor) {
   const auto start = std::chrono::steady_clock::now();
+  Watch watch(monitor);
   MajorantOctree tree;
   tree.bins = settings.spectral ? kSpectralBins : 3;
   tree.majorant_scale = settings.majorant_scale;
@@ -289,7 +323,10 @@ MajorantOctree build_majorant_octree(std::span<const Medium> media,
     members.push_back(Member{&h, &media[h.medium], s.data(), s.data() + bins});
   }
   for (const Member& m : members) tree.box = unite(tree.box, m.object->bounds);
-  if (tree.box.empty()) return tree;
+  if (tree.box.empty()) {
+    watch.report(1);
+    return tree;
+  }
   tree.half[0] = tree.box.extent() * 0.5;
   for (int l = 1; l <= kOctreeMaxDepth; ++l) tree.half[l] = tree.half[l - 1] * 0.5;
 
@@ -306,7 +343,10 @@ MajorantOctree build_majorant_octree(std::span<const Medium> media,
   g.levels.push_back(0);
   const int max_depth = std::clamp(settings.depth, 0, kOctreeMaxDepth);
   size_t begin = 0, end = 1;
+  const double interval_share = settings.sampled ? 0.5 : 1.0;
   for (int level = 0; level < max_depth; ++level) {
+    if (watch.cancelled()) return tree;
+    watch.report(interval_share * level / max_depth);
     const Vec3& half = tree.half[level];
     struct Candidate {
       double priority;
@@ -355,12 +395,14 @@ MajorantOctree build_majorant_octree(std::span<const Medium> media,
       scene.objects.push_back({*holders[i].tape, holders[i].bounds, holders[i].medium});
       if (!solid) scene.field_objects.push_back(static_cast<int>(i));
     }
-    sample_bounds(scene, solid ? 0 : -1, settings, sigma_t, tree, g);
+    sample_bounds(scene, solid ? 0 : -1, settings, sigma_t, tree, g, watch);
+    if (watch.cancelled()) return tree;
   }
   tree.nodes = std::move(g.nodes);
   tree.bounds = std::move(g.bounds);
   tree.build_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  watch.report(1);
   return tree;
 }
 

@@ -27,6 +27,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -101,12 +102,22 @@ struct OctreeMember {
   int medium;
 };
 
+// Watches a build that may take seconds (deep trees, sampled bounds, costly densities). Both are
+// optional; progress is called from one thread at a time with the fraction done, ending with 1
+// for a build that finishes. Once cancel returns true the build stops early and returns a tree
+// that must not be used.
+struct BuildMonitor {
+  std::function<void(double)> progress;
+  std::function<bool()> cancel;
+};
+
 // The octree over `members`' media: inside one solid object (`solid`: one member, whose medium
 // fills it) or over the field of index-matched objects (each medium present where its
 // object's F > 0, overlapping media adding up).
 MajorantOctree build_majorant_octree(std::span<const Medium> media,
                                      std::span<const OctreeMember> members, bool solid,
-                                     const OctreeSettings& settings);
+                                     const OctreeSettings& settings,
+                                     const BuildMonitor& monitor = {});
 
 // Calls leaf(node index, a, b) for every non-empty leaf the ray crosses in [t_min, t_max], front to
 // back, with [a, b] the ray's stretch inside it; consecutive stretches share their end points

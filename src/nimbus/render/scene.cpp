@@ -59,7 +59,7 @@ OctreeSettings octree_settings(const RenderSettings& settings) {
           settings.seed,      settings.spectral.mode == SpectralSettings::Mode::Spectral};
 }
 
-MajorantOctree build_majorant_octree(const Scene& scene, int inside) {
+MajorantOctree build_majorant_octree(const Scene& scene, int inside, const BuildMonitor& monitor) {
   std::vector<OctreeMember> members;
   auto add = [&](int i) {
     const SceneObject& obj = scene.objects[i];
@@ -70,16 +70,30 @@ MajorantOctree build_majorant_octree(const Scene& scene, int inside) {
   } else {
     for (int i : scene.field_objects) add(i);
   }
-  return build_majorant_octree(scene.media, members, inside >= 0, octree_settings(scene.settings));
+  return build_majorant_octree(scene.media, members, inside >= 0, octree_settings(scene.settings),
+                               monitor);
 }
 
-void build_majorant_octrees(Scene& scene) {
-  scene.field_octree = build_majorant_octree(scene, -1);
-  scene.solid_octrees.assign(scene.objects.size(), MajorantOctree{});
+void build_majorant_octrees(Scene& scene, const BuildMonitor& monitor) {
+  std::vector<int> solids;
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const SceneObject& obj = scene.objects[i];
     if (obj.medium >= 0 && obj.surface.type != Surface::Type::None)
-      scene.solid_octrees[i] = build_majorant_octree(scene, static_cast<int>(i));
+      solids.push_back(static_cast<int>(i));
+  }
+  // Each tree gets an equal share of the progress: their costs are not known in advance.
+  const double trees = double(solids.size() + 1);
+  auto part = [&](size_t k) {
+    BuildMonitor m{nullptr, monitor.cancel};
+    if (monitor.progress)
+      m.progress = [&monitor, k, trees](double f) { monitor.progress((double(k) + f) / trees); };
+    return m;
+  };
+  scene.field_octree = build_majorant_octree(scene, -1, part(0));
+  scene.solid_octrees.assign(scene.objects.size(), MajorantOctree{});
+  for (size_t k = 0; k < solids.size(); ++k) {
+    if (monitor.cancel && monitor.cancel()) return;
+    scene.solid_octrees[solids[k]] = build_majorant_octree(scene, solids[k], part(k + 1));
   }
 }
 

@@ -95,11 +95,13 @@ OctreeSettings octree_settings(const RenderSettings& settings);
 
 // The octree of the media a ray sees from `inside`: -1 for the field of index-matched objects,
 // else the index of a solid object holding a medium (only its medium, over its bounds).
-MajorantOctree build_majorant_octree(const Scene& scene, int inside);
+MajorantOctree build_majorant_octree(const Scene& scene, int inside,
+                                     const BuildMonitor& monitor = {});
 
 // (Re)builds every octree of the scene: the field's, and one per solid object with a medium.
-// Call after the objects, media and tracking settings are final.
-void build_majorant_octrees(Scene& scene);
+// Call after the objects, media and tracking settings are final. The monitor sees the fraction
+// of all of them done; once cancelled, the scene must not be rendered.
+void build_majorant_octrees(Scene& scene, const BuildMonitor& monitor = {});
 
 // The outward unit normal of an object at a point on its surface (F decreases outwards).
 Vec3 outward_normal(const SceneObject& object, const Vec3& p);

@@ -96,7 +96,7 @@ double optical_thickness_bound(const Scene& scene, const SceneObject& obj) {
 
 }  // namespace
 
-Scene compile_scene(const SceneDesc& desc) {
+Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor) {
   Scene scene;
   scene.settings.width = desc.film.width;
   scene.settings.height = desc.film.height;
@@ -138,7 +138,7 @@ Scene compile_scene(const SceneDesc& desc) {
     object_descs.push_back(&od);
   }
   for (const LightDesc& ld : desc.lights) scene.lights.push_back(compile_light(ld));
-  finish_scene(scene);
+  finish_scene(scene, monitor);
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const SceneObject& obj = scene.objects[i];
     if (obj.medium < 0) continue;
@@ -153,7 +153,7 @@ Scene compile_scene(const SceneDesc& desc) {
   return scene;
 }
 
-void finish_scene(Scene& scene) {
+void finish_scene(Scene& scene, const BuildMonitor& monitor) {
   scene.field_objects.clear();
   Box all;
   for (size_t i = 0; i < scene.objects.size(); ++i) {
@@ -168,7 +168,7 @@ void finish_scene(Scene& scene) {
                     scene.field_objects.size(), kMaxMediaAtPoint));
   if (!all.empty()) scene.scale = length(all.extent());
   complete_spectra(scene);
-  build_majorant_octrees(scene);
+  build_majorant_octrees(scene, monitor);
 }
 
 }  // namespace nimbus
