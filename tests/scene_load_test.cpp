@@ -70,9 +70,25 @@ struct BadScene {
   std::string message;
 };
 
+// Named shapes that each use the previous one twice: 2^levels spheres once compiled.
+std::string doubling_shapes(int levels) {
+  std::string shapes = R"("s0": {"type": "sphere", "radius": 1})";
+  for (int i = 1; i <= levels; ++i)
+    shapes +=
+        fmt::format(R"(, "s{}": {{"type": "union", "shapes": ["s{}", "s{}"]}})", i, i - 1, i - 1);
+  return with_camera(R"("media": {"m": {"sigma_s": 1}}, "shapes": {)" + shapes +
+                     fmt::format(R"(}}, "objects": [{{"shape": "s{}", "medium": "m"}}])", levels));
+}
+
 std::vector<BadScene> bad_scenes() {
   const std::string ball = R"({"type": "sphere", "radius": 1})";
   return {
+      // Issue 16: 2^26 spheres from 27 short definitions did not finish compiling in 20 s.
+      {"exponentially many quadrics",
+       doubling_shapes(17),
+       {},
+       "scene.json: /objects/0/shape: the shape holds more than 100000 quadrics (each use of a "
+       "named shape counts)"},
       {"root is not an object", "[1, 2]", {}, "scene.json: /: expected an object, not an array"},
       {"missing camera", "{}", {}, "scene.json: /camera: required key is missing"},
       {"misspelt section",

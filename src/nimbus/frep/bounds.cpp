@@ -11,9 +11,6 @@
 #include "nimbus/math/symmetric_eigen.h"
 
 namespace nimbus {
-namespace {
-
-constexpr double kInf = Box::kInf;
 
 // The box of {F > 0} for one quadric F = xᵀQx + lᵀx + k. With N = −Q positive semidefinite
 // and l in N's range, F = K − (x − c)ᵀ N (x − c) with c = N⁺l / 2 and K = k + lᵀc / 2: an
@@ -58,12 +55,16 @@ Box quadric_box(const Quadric& q) {
     for (int i = 0; i < 3; ++i)
       if (!range[i] && std::abs(eigen.vectors[i][j]) > kAxisTol) along_null = true;
     // A relative 1e-12 covers the round-off of the formula itself.
-    const double half = along_null ? kInf : std::sqrt(peak * n_pinv_diag[j]) * (1 + 1e-12);
+    const double half = along_null ? Box::kInf : std::sqrt(peak * n_pinv_diag[j]) * (1 + 1e-12);
     box.lo[j] = centre[j] - half;
     box.hi[j] = centre[j] + half;
   }
   return box;
 }
+
+namespace {
+
+constexpr double kInf = Box::kInf;
 
 Quadric operator+(const Quadric& p, const Quadric& q) {
   Quadric sum;

@@ -6,6 +6,11 @@
 namespace nimbus {
 
 struct Tape;
+struct Quadric;
+
+// The box of {q > 0} for one quadric (an ellipsoid, elliptic cylinder or slab), padded against
+// the formula's round-off; everything when that set is unbounded, empty when it is empty.
+Box quadric_box(const Quadric& q);
 
 struct Bounds {
   Box box;               // contains every point with F > 0; empty for an empty shape

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <unordered_map>
 #include <variant>
 
 #include "nimbus/frep/tape_eval.h"
@@ -103,6 +104,13 @@ std::vector<std::uint8_t> only_cubed(const Tape& tape) {
   return marks;
 }
 
+// The box grown on every side by `relative` times its diagonal (finite, non-empty boxes only).
+Box grown(const Box& box, double relative) {
+  if (box.empty() || !box.finite()) return box;
+  const double pad = relative * length(box.extent()) + 1e-300;
+  return {box.lo - Vec3{pad, pad, pad}, box.hi + Vec3{pad, pad, pad}};
+}
+
 // The box first_hit clips rays to: the bounds grown by a relative 1e-9 so that rounding in the
 // clip never shaves off a crossing on a tight face, or a huge cube for unbounded shapes.
 Box search_box(const Bounds& bounds) {
@@ -116,10 +124,45 @@ Box search_box(const Bounds& bounds) {
 
 }  // namespace
 
+namespace {
+
+// Quadrics under s, memoised per node (named shapes are shared), saturating at cap + 1.
+std::size_t count_quadrics(const ShapeDesc& s, std::size_t cap,
+                           std::unordered_map<const ShapeDesc*, std::size_t>& memo) {
+  if (const auto it = memo.find(&s); it != memo.end()) return it->second;
+  std::size_t n = 0;
+  const auto add = [&](const ShapePtr& child) {
+    if (child) n = std::min(cap + 1, n + count_quadrics(*child, cap, memo));
+  };
+  if (std::holds_alternative<QuadricNode>(s.node)) {
+    n = 1;
+  } else if (const auto* ff = std::get_if<FreeFormNode>(&s.node)) {
+    add(ff->base);
+    for (const Perturbation& p : ff->perturbations) add(p.shape);
+  } else {
+    for (const ShapePtr& child : std::get<CsgNode>(s.node).children) add(child);
+  }
+  memo[&s] = n;
+  return n;
+}
+
+}  // namespace
+
+std::size_t count_quadrics(const ShapeDesc& shape, std::size_t cap) {
+  std::unordered_map<const ShapeDesc*, std::size_t> memo;
+  return count_quadrics(shape, cap, memo);
+}
+
 Tape compile(const ShapeDesc& shape) {
+  if (count_quadrics(shape) > kMaxTapeQuadrics)
+    throw std::invalid_argument("compile: more than " + std::to_string(kMaxTapeQuadrics) +
+                                " quadrics in one shape");
   Tape tape;
   Compiler(tape).emit(shape, Mat4::identity(), 0);
   tape.only_cubed = only_cubed(tape);
+  tape.cubed_support.assign(tape.quadrics.size(), Box::everything());
+  for (size_t i = 0; i < tape.quadrics.size(); ++i)
+    if (tape.only_cubed[i]) tape.cubed_support[i] = grown(quadric_box(tape.quadrics[i]), 1e-9);
   tape.kind = classify(tape.code);
   if (tape.kind == TapeKind::FlatFreeForm)
     for (size_t k = 2; k < tape.code.size(); k += 2) tape.weights.push_back(tape.code[k].weight);
@@ -144,8 +187,11 @@ Vec3 gradient(const Tape& tape, const Vec3& p) {
 }
 
 Interval evaluate(const Tape& tape, const Box& box) {
-  return run_tape<Interval>(tape,
-                            [&](std::uint32_t i) { return quadric_range(tape.quadrics[i], box); });
+  return run_tape<Interval>(tape, [&](std::uint32_t i) {
+    // Where a perturbation is <= 0 it adds nothing, whatever its value: 0 says so.
+    if (intersect(tape.cubed_support[i], box).empty()) return Interval::point(0);
+    return quadric_range(tape.quadrics[i], box);
+  });
 }
 
 }  // namespace nimbus

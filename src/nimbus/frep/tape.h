@@ -4,6 +4,7 @@
 // F (> 0 inside) at a point, over a box, or along a ray, with one template interpreter
 // (tape_eval.h).
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -54,6 +55,10 @@ struct Tape {
   // Per quadric: 1 when its value is used only as a perturbation max(q, 0)³, so that where
   // q <= 0 nothing else about it matters.
   std::vector<std::uint8_t> only_cubed;
+  // Per quadric: for an only-cubed one, a box outside which it is <= 0 (quadric_box grown by a
+  // relative 1e-9), so that interval evaluation over a box elsewhere skips it: a free form's
+  // perturbations are mostly small and far apart. Everything for the others.
+  std::vector<Box> cubed_support;
   Bounds bounds;
   // Where first_hit looks: the bounds padded against round-off, or, for an unbounded shape,
   // its box cut to |x_i| <= kUnboundedExtent (the scene loader clips those anyway).
@@ -64,8 +69,19 @@ struct Tape {
 
 constexpr double kUnboundedExtent = 1e6;
 
-// Throws std::invalid_argument on a null shape, an empty CSG node or nesting deeper than
-// kMaxRegisters; otherwise assumes a valid tree (the scene loader checks it).
+// The most quadrics one tape may hold. A shape used twice is compiled twice, so a few named
+// shapes that each use the previous one twice describe 2^k quadrics: the limit keeps such a file
+// from exhausting memory and time. Real free forms stay far below (10^4 perturbations compile
+// in under a second).
+constexpr std::size_t kMaxTapeQuadrics = 100000;
+
+// The quadrics compile() would emit for the shape, counting shared sub-shapes once per use;
+// the count stops just above `cap` (so any shape is counted quickly).
+std::size_t count_quadrics(const ShapeDesc& shape, std::size_t cap = kMaxTapeQuadrics);
+
+// Throws std::invalid_argument on a null shape, an empty CSG node, nesting deeper than
+// kMaxRegisters or more than kMaxTapeQuadrics quadrics; otherwise assumes a valid tree (the
+// scene loader checks it).
 Tape compile(const ShapeDesc& shape);
 
 double evaluate(const Tape& tape, const Vec3& p);     // F(p), > 0 inside

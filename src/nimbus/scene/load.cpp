@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "nimbus/frep/primitives.h"
+#include "nimbus/frep/tape.h"
 #include "nimbus/media/octree.h"
 #include "nimbus/render/scene.h"
 #include "nimbus/render/setting_names.h"
@@ -303,6 +304,10 @@ class Loader {
     const JsonValue shape_value = o.required("shape");
     obj.shape = shape(shape_value);
     obj.shape_name = shape_value.json().is_string() ? shape_value.string() : "inline";
+    if (count_quadrics(*obj.shape) > kMaxTapeQuadrics)
+      shape_value.fail(
+          fmt::format("the shape holds more than {} quadrics (each use of a named shape counts)",
+                      kMaxTapeQuadrics));
     const auto medium = o.optional("medium");
     if (medium) {
       const auto it = media_index_.find(medium->string());
