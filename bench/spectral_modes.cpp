@@ -6,12 +6,14 @@
 // converge to slightly different colours where RGB inputs are upsampled), and the noise at equal
 // time relative to rgb mode, sqrt(variance × time per sample / (rgb's)). Output: Markdown.
 //
-// Usage: spectral_modes [--spp N] [--reps N] [--width N] [scene.json]
-// Defaults: 8 spp, 3 repetitions, width 160 (height kept in proportion), scenes/cloud.json.
+// Usage: spectral_modes [--spp N] [--reps N] [--width N] [--wavelengths N,N,...] [scene.json]
+// Defaults: 8 spp, 3 repetitions, width 160 (height kept in proportion), wavelengths 4,8,
+// scenes/cloud.json.
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -40,6 +42,7 @@ double median(std::vector<double> v) {
 
 int main(int argc, char** argv) {
   int spp = 8, reps = 3, width = 160;
+  std::vector<int> wavelengths = {4, 8};
   std::string scene_path = std::string(NIMBUS_SOURCE_DIR) + "/scenes/cloud.json";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -49,14 +52,21 @@ int main(int argc, char** argv) {
       reps = std::stoi(argv[++i]);
     else if (a == "--width" && i + 1 < argc)
       width = std::stoi(argv[++i]);
-    else
+    else if (a == "--wavelengths" && i + 1 < argc) {
+      wavelengths.clear();
+      std::stringstream list(argv[++i]);
+      for (std::string n; std::getline(list, n, ',');) wavelengths.push_back(std::stoi(n));
+    } else
       scene_path = a;
   }
-  std::vector<Mode> modes = {
-      {"rgb", {"spectrum.mode=\"rgb\""}, {}},
-      {"spectral, N = 4", {"spectrum.mode=\"spectral\"", "spectrum.wavelengths=4"}, {}},
-      {"spectral, N = 8", {"spectrum.mode=\"spectral\"", "spectrum.wavelengths=8"}, {}},
-  };
+  std::vector<std::string> names = {"rgb"};
+  std::vector<Mode> modes = {{"", {"spectrum.mode=\"rgb\""}, {}}};
+  for (int n : wavelengths) {
+    names.push_back("spectral, N = " + std::to_string(n));
+    modes.push_back(
+        {"", {"spectrum.mode=\"spectral\"", "spectrum.wavelengths=" + std::to_string(n)}, {}});
+  }
+  for (size_t i = 0; i < modes.size(); ++i) modes[i].name = names[i].c_str();
   std::string tracking;
   for (int rep = 0; rep < reps; ++rep)
     for (Mode& mode : modes) {

@@ -257,22 +257,25 @@ TEST_F(Cli, RendersInSpectralModeFromTheCommandLine) {
   const Outcome r =
       run("render scene.json --stats stats.json --set film.width=8 --spp 2 --set "
           "spectrum.mode=spectral "
-          "--set spectrum.wavelengths=6 -o s.exr --quiet");
+          "--set spectrum.wavelengths=12 -o s.exr --quiet");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir_ / "s.exr"));
   std::ifstream f(dir_ / "stats.json");
   const nlohmann::json s = nlohmann::json::parse(f);
   EXPECT_EQ(s["spectrum"]["mode"], "spectral");
-  EXPECT_EQ(s["spectrum"]["channels"], 6);
+  EXPECT_EQ(s["spectrum"]["channels"], 12);
   for (int c = 0; c < 3; ++c) EXPECT_GT(s["image_mean"][c].get<double>(), 0);
-  // A wavelength count out of range is a scene error: exit 2, one line, no output.
-  const Outcome bad =
-      run("render scene.json --set spectrum.mode=spectral "
-          "--set spectrum.wavelengths=32 -o bad.exr");
-  EXPECT_EQ(bad.code, 2);
-  EXPECT_NE(bad.err.find("/spectrum/wavelengths: must be in [4, 16]"), std::string::npos)
-      << bad.err;
-  EXPECT_FALSE(fs::exists(dir_ / "bad.exr"));
+  // A wavelength count this build does not render is a scene error: exit 2, one line, no output.
+  for (const char* n : {"6", "32"}) {
+    const Outcome bad = run(std::string("render scene.json --set spectrum.mode=spectral ") +
+                            "--set spectrum.wavelengths=" + n + " -o bad.exr");
+    EXPECT_EQ(bad.code, 2);
+    EXPECT_NE(bad.err.find("/spectrum/wavelengths: must be one of 4, 8, 12, 16 (the counts this "
+                           "build renders: CMake option NIMBUS_WAVELENGTH_COUNTS)\n"),
+              std::string::npos)
+        << bad.err;
+    EXPECT_FALSE(fs::exists(dir_ / "bad.exr"));
+  }
 }
 
 // Issue 16: SIGINT and SIGTERM stop a render cleanly: exit 128 + the signal, one line, and no

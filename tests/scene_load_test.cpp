@@ -288,7 +288,8 @@ std::vector<BadScene> bad_scenes() {
       {"too few wavelengths",
        with_camera(R"("spectrum": {"mode": "spectral", "wavelengths": 3})"),
        {},
-       "scene.json: /spectrum/wavelengths: must be in [4, 16]"},
+       "scene.json: /spectrum/wavelengths: must be one of 4, 8, 12, 16 (the counts this build "
+       "renders: CMake option NIMBUS_WAVELENGTH_COUNTS)"},
       {"sampled spectrum not increasing",
        with_medium(R"({"sigma_s": {"spectrum": [[400, 1], [700, 2], [650, 3]]}})"),
        {},

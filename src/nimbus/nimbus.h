@@ -23,5 +23,6 @@
 #include "nimbus/render/renderer.h"
 #include "nimbus/render/scene.h"
 #include "nimbus/render/stats.h"
+#include "nimbus/render/wavelength_counts.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"

@@ -1,8 +1,8 @@
 #pragma once
-// The render loop for one channel count N (3: rgb mode; kMinWavelengths..kMaxWavelengths:
-// spectral mode), instantiated once per N in its own translation unit
-// (render/render_channels.cpp.in) so the instantiations build in parallel; renderer.cpp
-// dispatches once per render.
+// The render loop for one channel count N (3: rgb mode; the built wavelength counts: spectral
+// mode), instantiated once per N in its own translation unit (render/render_channels.cpp.in) so
+// the instantiations build in parallel; renderer.cpp dispatches once per render
+// (wavelength_counts.h).
 
 #include <tbb/blocked_range2d.h>
 #include <tbb/enumerable_thread_specific.h>

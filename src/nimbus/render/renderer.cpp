@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "nimbus/render/wavelength_counts.h"
+
 namespace nimbus {
 
 // Instantiated in generated translation units (CMakeLists.txt, render_channels.cpp.in).
@@ -15,17 +17,6 @@ RenderStats render_channels(const Scene& scene, Film& film, const RenderRange& r
                             const RenderOptions& options, int threads);
 
 namespace {
-
-template <int N>
-RenderStats dispatch(const Scene& scene, Film& film, const RenderRange& range,
-                     const RenderOptions& options, int threads, int n) {
-  if constexpr (N > kMaxWavelengths) {
-    throw std::invalid_argument("spectral mode: " + std::to_string(n) + " wavelengths");
-  } else {
-    if (n == N) return render_channels<N>(scene, film, range, options, threads);
-    return dispatch<N + 1>(scene, film, range, options, threads, n);
-  }
-}
 
 // The range with its open ends resolved, checked against the film.
 RenderRange resolve(const Scene& scene, const Film& film, RenderRange r) {
@@ -58,12 +49,7 @@ RenderStats render_into(const Scene& scene, Film& film, const RenderOptions& opt
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
   if (scene.settings.spectral.mode == SpectralSettings::Mode::Rgb)
     return render_channels<3>(scene, film, range, options, threads);
-  const int n = scene.settings.spectral.wavelengths;
-  if (n < kMinWavelengths || n > kMaxWavelengths)
-    throw std::invalid_argument("spectral mode needs " + std::to_string(kMinWavelengths) + " to " +
-                                std::to_string(kMaxWavelengths) + " wavelengths, not " +
-                                std::to_string(n));
-  return dispatch<kMinWavelengths>(scene, film, range, options, threads, n);
+  return render_spectral(scene.settings.spectral.wavelengths, scene, film, range, options, threads);
 }
 
 RenderResult render(const Scene& scene, const RenderOptions& options) {

@@ -39,9 +39,8 @@ struct TrackingSettings {
 struct SpectralSettings {
   enum class Mode { Rgb, Spectral };
   Mode mode = Mode::Rgb;
-  int wavelengths = 8;  // spectral mode: kMinWavelengths..kMaxWavelengths
+  int wavelengths = 8;  // spectral mode: one of built_wavelength_counts() (wavelength_counts.h)
 };
-inline constexpr int kMinWavelengths = 4, kMaxWavelengths = 16;
 
 struct RenderSettings {
   int width = 640, height = 480;

@@ -1,6 +1,7 @@
 #include "nimbus/scene/load.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cerrno>
 #include <cmath>
@@ -17,6 +18,7 @@
 #include "nimbus/media/octree.h"
 #include "nimbus/render/scene.h"
 #include "nimbus/render/setting_names.h"
+#include "nimbus/render/wavelength_counts.h"
 #include "nimbus/scene/density_types.h"
 
 namespace nimbus {
@@ -196,8 +198,14 @@ class Loader {
     JsonObject o(v);
     SpectrumDesc d;
     if (auto x = o.optional("mode")) d.mode = choice_of(*x, "spectrum mode", kSpectrumModeNames);
-    if (auto x = o.optional("wavelengths"))
-      d.wavelengths = x->integer(between(kMinWavelengths, kMaxWavelengths));
+    if (auto x = o.optional("wavelengths")) {
+      d.wavelengths = x->integer();
+      if (!is_built_wavelength_count(d.wavelengths))
+        x->fail(
+            fmt::format("must be one of {} (the counts this build renders: CMake option "
+                        "NIMBUS_WAVELENGTH_COUNTS)",
+                        fmt::join(built_wavelength_counts(), ", ")));
+    }
     o.finish();
     return d;
   }
