@@ -333,7 +333,7 @@ TEST_F(Cli, RendersThatWouldNotFitAreRefusedUpFront) {
       "render scene.json --set film.width=16384 --set film.height=16384 --max-memory 16G -o a.png");
   EXPECT_EQ(big.code, 2);
   EXPECT_EQ(big.err,
-            "nimbus: the render needs about 19.0 GiB (film 13.0 GiB, image 6.0 GiB, majorant "
+            "nimbus: the render needs about 25.0 GiB (film 19.0 GiB, image 6.0 GiB, majorant "
             "octrees 42.0 MiB), more than the 16.0 GiB allowed by --max-memory\n");
   EXPECT_TRUE(outputs().empty());
   const Outcome bad = run("render scene.json --max-memory 10x -o a.png");

@@ -535,8 +535,8 @@ TEST(MediaRenderPhase, ExtremeAsymmetryRendersFinitePixels) {
         const RenderResult r = render(scene);
         for (int p = 0; p < r.film.pixels(); ++p)
           for (int c = 0; c < 3; ++c)
-            ASSERT_TRUE(std::isfinite(r.film.sum[p][c]) && std::isfinite(r.film.sum_sq[p][c]))
-                << r.film.sum[p][c] << " " << r.film.sum_sq[p][c] << " "
+            ASSERT_TRUE(std::isfinite(r.film.sum[p].value()[c]) && std::isfinite(r.film.sum_sq[p][c]))
+                << r.film.sum[p].value()[c] << " " << r.film.sum_sq[p][c] << " "
                 << "g " << g << ", mode " << int(mode) << (spectral ? ", spectral" : "")
                 << ", pixel " << p;
       }

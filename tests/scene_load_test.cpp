@@ -85,9 +85,9 @@ std::vector<BadScene> bad_scenes() {
   return {
       // Issue 16: 2^26 spheres from 27 short definitions did not finish compiling in 20 s.
       {"exponentially many quadrics",
-       doubling_shapes(17),
+       doubling_shapes(15),
        {},
-       "scene.json: /objects/0/shape: the shape holds more than 100000 quadrics (each use of a "
+       "scene.json: /objects/0/shape: the shape holds more than 20000 quadrics (each use of a "
        "named shape counts)"},
       {"root is not an object", "[1, 2]", {}, "scene.json: /: expected an object, not an array"},
       {"missing camera", "{}", {}, "scene.json: /camera: required key is missing"},

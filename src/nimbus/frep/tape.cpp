@@ -33,16 +33,24 @@ class Compiler {
   void emit_node(const QuadricNode& node, const Mat4& world, int reg) {
     const auto index = static_cast<std::uint32_t>(tape_.quadrics.size());
     tape_.quadrics.push_back(transformed(node.q, world));
+    // Where a quadric is <= 0, [-inf, 0] encloses it. That keeps what unions and intersections
+    // need (the sign of the upper bound) but not what a sum needs (how far below 0 a free form's
+    // base lies, which perturbations must overcome) nor what negation turns into the upper bound.
+    tape_.cullable.push_back(!negated_ && summed_depth_ == 0);
     push({Op::Quadric, reg16(reg), 0, index, 0});
   }
 
   void emit_node(const FreeFormNode& node, const Mat4& world, int reg) {
+    ++summed_depth_;
     emit_child(node.base, world, reg);
+    --summed_depth_;
     for (const Perturbation& p : node.perturbations) {
       if (!p.shape) throw std::invalid_argument("compile: null perturbation");
       // A zero weight leaves F unchanged (eq. 1); do not pay for it.
       if (p.weight == 0) continue;
+      ++summed_depth_;
       emit(*p.shape, world, reg + 1);
+      --summed_depth_;
       push({Op::AddCubePos, reg16(reg), reg16(reg + 1), 0, p.weight});
     }
   }
@@ -51,7 +59,10 @@ class Compiler {
     if (node.children.empty()) throw std::invalid_argument("compile: empty CSG node");
     emit_child(node.children[0], world, reg);
     for (size_t i = 1; i < node.children.size(); ++i) {
+      const bool subtrahend = node.op == CsgOp::Difference;
+      negated_ ^= subtrahend;
       emit_child(node.children[i], world, reg + 1);
+      negated_ ^= subtrahend;
       switch (node.op) {
         case CsgOp::Union:
           push({Op::Max, reg16(reg), reg16(reg + 1), 0, 0});
@@ -71,6 +82,8 @@ class Compiler {
   void push(const Instr& in) { tape_.code.push_back(in); }
 
   Tape& tape_;
+  bool negated_ = false;  // the node being emitted is negated (an odd number of times)
+  int summed_depth_ = 0;  // how many free forms' sums (base or perturbation) the node lies in
 };
 
 // FlatFreeForm: Quadric(r0) followed by pairs Quadric(r1), AddCubePos(r0 += w · r1).
@@ -160,9 +173,10 @@ Tape compile(const ShapeDesc& shape) {
   Tape tape;
   Compiler(tape).emit(shape, Mat4::identity(), 0);
   tape.only_cubed = only_cubed(tape);
-  tape.cubed_support.assign(tape.quadrics.size(), Box::everything());
+  tape.cull_box.assign(tape.quadrics.size(), Box::everything());
   for (size_t i = 0; i < tape.quadrics.size(); ++i)
-    if (tape.only_cubed[i]) tape.cubed_support[i] = grown(quadric_box(tape.quadrics[i]), 1e-9);
+    if (tape.only_cubed[i] || tape.cullable[i])
+      tape.cull_box[i] = grown(quadric_box(tape.quadrics[i]), 1e-9);
   tape.kind = classify(tape.code);
   if (tape.kind == TapeKind::FlatFreeForm)
     for (size_t k = 2; k < tape.code.size(); k += 2) tape.weights.push_back(tape.code[k].weight);
@@ -188,8 +202,10 @@ Vec3 gradient(const Tape& tape, const Vec3& p) {
 
 Interval evaluate(const Tape& tape, const Box& box) {
   return run_tape<Interval>(tape, [&](std::uint32_t i) {
-    // Where a perturbation is <= 0 it adds nothing, whatever its value: 0 says so.
-    if (intersect(tape.cubed_support[i], box).empty()) return Interval::point(0);
+    // Over a box outside the quadric's positive set: a perturbation adds nothing, whatever its
+    // value (0 says so), and anything else is enclosed by [-inf, 0] (see Compiler).
+    if (intersect(tape.cull_box[i], box).empty())
+      return tape.only_cubed[i] ? Interval::point(0) : Interval{-Box::kInf, 0.0};
     return quadric_range(tape.quadrics[i], box);
   });
 }

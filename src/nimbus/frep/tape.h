@@ -55,10 +55,14 @@ struct Tape {
   // Per quadric: 1 when its value is used only as a perturbation max(q, 0)³, so that where
   // q <= 0 nothing else about it matters.
   std::vector<std::uint8_t> only_cubed;
-  // Per quadric: for an only-cubed one, a box outside which it is <= 0 (quadric_box grown by a
-  // relative 1e-9), so that interval evaluation over a box elsewhere skips it: a free form's
-  // perturbations are mostly small and far apart. Everything for the others.
-  std::vector<Box> cubed_support;
+  // Per quadric: whether interval evaluation may enclose it by [-inf, 0] where it is <= 0 (not
+  // for a difference's subtrahend outside perturbations, whose lower bound matters).
+  std::vector<std::uint8_t> cullable;
+  // Per quadric that is only cubed or cullable: a box outside which it is <= 0 (quadric_box
+  // grown by a relative 1e-9), so that interval evaluation over a box elsewhere skips it: a free
+  // form's perturbations and a large union's children are mostly small and far apart.
+  // Everything for the others.
+  std::vector<Box> cull_box;
   Bounds bounds;
   // Where first_hit looks: the bounds padded against round-off, or, for an unbounded shape,
   // its box cut to |x_i| <= kUnboundedExtent (the scene loader clips those anyway).
@@ -71,9 +75,10 @@ constexpr double kUnboundedExtent = 1e6;
 
 // The most quadrics one tape may hold. A shape used twice is compiled twice, so a few named
 // shapes that each use the previous one twice describe 2^k quadrics: the limit keeps such a file
-// from exhausting memory and time. Real free forms stay far below (10^4 perturbations compile
-// in under a second).
-constexpr std::size_t kMaxTapeQuadrics = 100000;
+// from exhausting memory and time. A free form of 10 000 scattered perturbations loads and
+// renders a tiny image in 1 s; coincident quadrics are the worst case (interval evaluation cannot
+// skip any of them): 8 192 coincident spheres take 9 s.
+constexpr std::size_t kMaxTapeQuadrics = 20000;
 
 // The quadrics compile() would emit for the shape, counting shared sub-shapes once per use;
 // the count stops just above `cap` (so any shape is counted quickly).

@@ -14,7 +14,7 @@ namespace nimbus {
 namespace {
 
 constexpr char kFilmMagic[8] = {'N', 'I', 'M', 'F', 'I', 'L', 'M', '\0'};
-constexpr uint32_t kFilmVersion = 1;
+constexpr uint32_t kFilmVersion = 2;  // 2: exact sums (128-bit fixed point)
 static_assert(std::endian::native == std::endian::little, "film files are little endian");
 
 }  // namespace
@@ -29,7 +29,7 @@ void save_film(const Film& film, const std::string& path) {
     put(static_cast<int32_t>(film.height));
     for (int p = 0; p < film.pixels(); ++p) {
       put(film.samples[p]);
-      for (int c = 0; c < 3; ++c) put(film.sum[p][c]);
+      for (int c = 0; c < 3; ++c) put(film.sum[p].c[c]);
       for (int c = 0; c < 3; ++c) put(film.sum_sq[p][c]);
     }
     out.flush();
@@ -61,7 +61,7 @@ Film load_film(const std::string& path) {
   Film film(w, h);
   for (int p = 0; p < film.pixels(); ++p) {
     get(film.samples[p]);
-    for (int c = 0; c < 3; ++c) get(film.sum[p][c]);
+    for (int c = 0; c < 3; ++c) get(film.sum[p].c[c]);
     for (int c = 0; c < 3; ++c) get(film.sum_sq[p][c]);
   }
   if (in.peek() != std::char_traits<char>::eof())

@@ -15,7 +15,7 @@ namespace nimbus {
 MemoryEstimate estimate_render_memory(int width, int height, int octrees, int bins, int threads) {
   const double pixels = double(width) * double(height);
   MemoryEstimate e;
-  e.film = pixels * (2 * sizeof(Rgb) + sizeof(uint32_t));
+  e.film = pixels * (sizeof(ExactRgb) + sizeof(Rgb) + sizeof(uint32_t));
   // The float image, and as much again for a writer's rows (EXR slices, PNG bytes).
   e.image = 2 * pixels * 3 * sizeof(float);
   // At the node budget, while building: the node, its bounds, its centre and level, and the

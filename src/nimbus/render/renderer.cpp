@@ -34,7 +34,8 @@ RenderRange resolve(const Scene& scene, const Film& film, RenderRange r) {
     throw std::invalid_argument(fmt::format("samples [{}, {}) are not a range", r.s0, r.s1));
   for (int y = r.y0; y < r.y1; ++y)
     for (int x = r.x0; x < r.x1; ++x)
-      if (film.samples[size_t(y) * W + x] != uint32_t(r.s0))
+      if (const uint32_t held = film.samples[size_t(y) * W + x];
+          held != 0 && held != uint32_t(r.s0))
         throw std::invalid_argument(
             fmt::format("pixel ({}, {}) holds {} samples; samples [{}, {}) continue from {}", x, y,
                         film.samples[size_t(y) * W + x], r.s0, r.s1, r.s0));

@@ -1,8 +1,8 @@
 #pragma once
 // Renders a compiled scene over tiles in parallel (oneTBB). Each pixel sample draws from its own
-// random stream keyed by (seed, pixel, sample index) and each pixel's samples are added to the
-// film in sample order, so the image is bit-identical for any thread count, and for any split of
-// the pixels, or of the samples into consecutive ranges, between renders (render/film.h).
+// random stream keyed by (seed, pixel, sample index) and the film's sums are exact, so the image
+// is bit-identical for any thread count and any split of the pixels or of the samples between
+// renders, merged in any order (render/film.h).
 
 #include <functional>
 
@@ -36,8 +36,10 @@ struct RenderStats {
   bool cancelled = false;
 };
 
-// Adds the samples of options.range to `film`, which must have the scene's size and hold exactly
-// range.s0 samples in every pixel of the range (else std::invalid_argument, naming the pixel).
+// Adds the samples of options.range to `film`, which must have the scene's size; each pixel of
+// the range must hold either no samples (a film may start at any sample index, e.g. one of
+// several processes sharing a pixel's samples) or exactly range.s0 (it continues where it left
+// off); else std::invalid_argument, naming the pixel.
 RenderStats render_into(const Scene& scene, Film& film, const RenderOptions& options = {});
 
 struct RenderResult {
