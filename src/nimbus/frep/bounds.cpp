@@ -64,8 +64,6 @@ Box quadric_box(const Quadric& q) {
 
 namespace {
 
-constexpr double kInf = Box::kInf;
-
 Quadric operator+(const Quadric& p, const Quadric& q) {
   Quadric sum;
   for (int i = 0; i < 10; ++i) sum.a[i] = p.a[i] + q.a[i];
