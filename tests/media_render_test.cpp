@@ -161,6 +161,9 @@ double max_z(const MeanEstimate& m, const Rgb& ref) {
 // pass anything); and a render of a deliberately wrong scene is told apart (power).
 void expect_mean(const RenderResult& r, const RenderResult& wrong, const Rgb& ref,
                  double se_bound) {
+  // Issue 13: no sample may reach the film as NaN or infinity (the film would refuse it).
+  EXPECT_EQ(r.counters.rejected_samples, 0u);
+  EXPECT_EQ(wrong.counters.rejected_samples, 0u);
   const MeanEstimate m = image_mean(r.film);
   for (int c = 0; c < 3; ++c) {
     EXPECT_GT(m.standard_error[c], 0) << "the medium must make some noise";
@@ -233,6 +236,7 @@ std::vector<Rgb> pixel_references(const Camera& camera, int width, int height, i
 // The per-pixel chi-square of a render of the unit sphere against reference pixel values,
 // inside its outline.
 test::Chi2 sphere_chi2(const RenderResult& r, const Camera& camera, const std::vector<Rgb>& ref) {
+  EXPECT_EQ(r.counters.rejected_samples, 0u);
   const int w = r.film.width;
   return test::film_chi2(
       r.film, [&](int p) { return ref[p]; },

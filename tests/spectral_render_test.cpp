@@ -118,6 +118,9 @@ std::optional<std::string> unfit(const SpectralCase& c, const Scene& scene, bool
 // `se_bound`, and a render of a deliberately wrong scene told apart (power).
 void expect_mean(const RenderResult& r, const RenderResult& wrong, const Rgb& ref,
                  double se_bound) {
+  // Issue 13: no sample may reach the film as NaN or infinity (the film would refuse it).
+  EXPECT_EQ(r.counters.rejected_samples, 0u);
+  EXPECT_EQ(wrong.counters.rejected_samples, 0u);
   const MeanEstimate est = image_mean(r.film), bad = image_mean(wrong.film);
   double z_wrong = 0;
   for (int ch = 0; ch < 3; ++ch) {
