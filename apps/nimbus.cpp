@@ -1,4 +1,5 @@
-// The nimbus command line: `nimbus render SCENE ...` and `nimbus experiment NAME --out DIR`.
+// The nimbus command line: `nimbus render SCENE ...`, `nimbus experiment NAME --out DIR` and
+// `nimbus export-vdb SCENE -o OUT.vdb --voxel-size H`.
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -6,6 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -21,6 +23,7 @@
 #include "nimbus/io/atomic_file.h"
 #include "nimbus/io/film_image.h"
 #include "nimbus/io/output.h"
+#include "nimbus/io/vdb_export.h"
 #include "nimbus/render/memory_estimate.h"
 #include "nimbus/render/path_spectra.h"
 #include "nimbus/render/renderer.h"
@@ -319,6 +322,86 @@ int run_experiment(const ExperimentArgs& args) {
   return 0;
 }
 
+struct ExportArgs {
+  std::string scene;
+  std::string output;
+  double voxel_size = 0;
+  int object = -1;  // -1: the first object that holds a medium
+  std::vector<std::string> sets;
+  bool quiet = false;
+};
+
+// `nimbus export-vdb`: one object's medium as an OpenVDB fog volume (io/vdb_export.h). Bad input
+// (the scene, the object, the voxel size, the output path) is exit 2 with one line and nothing
+// written; a signal stops the build as it stops a render.
+int run_export_vdb(const ExportArgs& args) {
+  using namespace nimbus;
+  try {
+    check_writable_path(args.output);
+    std::string ext = std::filesystem::path(args.output).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return std::tolower(c); });
+    if (ext != ".vdb") throw std::runtime_error(args.output + ": unknown volume format (use .vdb)");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "nimbus: %s\n", e.what());
+    return kExitBadInput;
+  }
+  Scene scene;
+  int object = -1;
+  try {
+    SceneDesc desc = load_scene_file(args.scene, args.sets);
+    object = vdb_export_object(desc, args.object);
+    // The export needs the objects' functions and media, not the renderer's majorants.
+    desc.integrator.tracking.octree_depth = 0;
+    desc.integrator.tracking.majorant_source = TrackingSettings::MajorantSource::Bound;
+    scene = compile_scene(desc);
+  } catch (const SceneError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return kExitBadInput;
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "nimbus: %s\n", e.what());
+    return kExitBadInput;
+  }
+  const bool show_progress = !args.quiet && isatty(fileno(stderr));
+  const auto start = std::chrono::steady_clock::now();
+  BuildMonitor monitor;
+  monitor.cancel = [] { return g_signal.load() != 0; };
+  // The fraction 1 comes once the grid is built, before it is written: from then on a signal
+  // removes the temporary file and ends the process (catch_stop_signals).
+  monitor.progress = [&](double f) {
+    if (f >= 1) g_writing = true;
+    if (show_progress)
+      print_progress(
+          "export", f,
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  };
+  VdbExportResult result;
+  try {
+    result = export_vdb(scene, object, args.voxel_size, args.output, monitor);
+  } catch (const std::invalid_argument& e) {
+    if (show_progress) std::fprintf(stderr, "\n");
+    std::fprintf(stderr, "nimbus: %s\n", e.what());
+    return kExitBadInput;
+  }
+  g_writing = false;
+  if (show_progress) std::fprintf(stderr, "\n");
+  if (result.cancelled) {
+    const int sig = g_signal.load();
+    std::fprintf(stderr, "nimbus: stopped by %s while building the grid; nothing written\n",
+                 signal_name(sig));
+    return 128 + sig;
+  }
+  if (!args.quiet)
+    std::fprintf(stderr,
+                 "nimbus: object %d: %llu active voxels of size %g, largest density %.4g, in %.2f "
+                 "s -> %s\n",
+                 object, static_cast<unsigned long long>(result.active_voxels), args.voxel_size,
+                 result.max_density,
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+                 args.output.c_str());
+  return 0;
+}
+
 }  // namespace
 
 // An integer option's check that says its range in words: "--spp must be >= 1, not 0". (CLI11's
@@ -386,6 +469,20 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   experiment->add_flag("--no-plot", exp.no_plot, "Write the CSV files only");
 
+  ExportArgs exp_vdb;
+  CLI::App* export_vdb = app.add_subcommand(
+      "export-vdb", "Write an object's medium as an OpenVDB fog volume (docs/cli.md)");
+  export_vdb->add_option("scene", exp_vdb.scene, "Scene file (JSON)")->required();
+  export_vdb->add_option("-o,--output", exp_vdb.output, "Output file (.vdb)")->required();
+  export_vdb->add_option("--voxel-size", exp_vdb.voxel_size, "Voxel size H in world units (> 0)")
+      ->required();
+  export_vdb
+      ->add_option("--object", exp_vdb.object,
+                   "Index into the scene's objects (default: the first with a medium)")
+      ->check(integer_in(0));
+  export_vdb->add_option("--set", exp_vdb.sets, "Override a scene key, as for render; repeatable");
+  export_vdb->add_flag("-q,--quiet", exp_vdb.quiet, "Print nothing but errors");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -395,6 +492,7 @@ int main(int argc, char** argv) {
   try {
     if (experiment->parsed()) return run_experiment(exp);
     catch_stop_signals();
+    if (export_vdb->parsed()) return run_export_vdb(exp_vdb);
     return run_render(args);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "nimbus: %s\n", e.what());

@@ -13,6 +13,7 @@
 #include "nimbus/frep/tape.h"
 #include "nimbus/math/rng.h"
 #include "nimbus/scene/density_types.h"
+#include "support/vdb_grids.h"
 
 namespace nimbus {
 namespace {
@@ -21,10 +22,16 @@ TEST(Density, EveryTypesRangeHoldsItsValues) {
   // The holding object's function: a unit sphere's 1 − |x|², evaluated as the octree does.
   const Tape tape = compile(*make_shape(QuadricNode{sphere({0, 0, 0}, 1)}));
   const JsonOrigin origin{"test", {}};
+  // The types' required keys: a VDB grid (a rippled ball a little larger than the sphere).
+  const test::TempDir dir("density_test");
+  test::write_ball_vdb(dir.file("ball.vdb"), 12, 0.1, {0, 0, 0});
+  const nlohmann::json required = {{"vdb", {{"file", dir.file("ball.vdb")}}}};
   Rng rng(3);
   for (const DensityType& type : density_types()) {
     SCOPED_TRACE(std::string(type.name));
-    const nlohmann::json params = nlohmann::json::object();
+    const std::string name(type.name);
+    const nlohmann::json params =
+        required.contains(name) ? required[name] : nlohmann::json::object();
     JsonObject o(JsonValue(params, "/density", origin));
     const DensityPtr density = type.read(o);
     ASSERT_NE(density, nullptr);

@@ -5,6 +5,9 @@ packages=(
   build-essential cmake pkg-config clang libclang-rt-14-dev
   libtbb-dev libopenexr-dev libpng-dev nlohmann-json3-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  # OpenVDB volumes: the library, NanoVDB, Boost.Iostreams for OpenVDB's CMake module, and
+  # vdb_print, which the tests run on exported files
+  libopenvdb-dev libnanovdb-dev libboost-iostreams-dev libopenvdb-tools
   colord-data python3-numpy python3-matplotlib
 )
 missing=()

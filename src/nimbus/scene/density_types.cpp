@@ -1,8 +1,12 @@
 #include "nimbus/scene/density_types.h"
 
+#include <filesystem>
+
 #include "nimbus/media/cloud_density.h"
 #include "nimbus/media/constant_density.h"
 #include "nimbus/media/field_density.h"
+#include "nimbus/media/vdb_density.h"
+#include "nimbus/scene/load.h"
 
 namespace nimbus {
 namespace {
@@ -28,6 +32,32 @@ DensityPtr read_cloud(JsonObject& d) {
   return make_cloud_density(p);
 }
 
+// docs/scene-format.md: a grid of a .vdb or .nvdb file (relative to the scene file's folder), by
+// name, moved further by an optional transform. The file is read here, so that every problem
+// with it is a load error naming the key at fault and the file.
+DensityPtr read_vdb(JsonObject& d) {
+  const JsonValue file = d.required("file");
+  const auto grid = d.optional("grid");
+  const auto transform = d.optional("transform");
+  VdbParams p;
+  const std::filesystem::path path = file.string();
+  if (path.empty()) file.fail("must name a file");
+  p.file = (std::filesystem::path(d.value().origin().folder) / path).string();
+  if (grid) p.grid = grid->string();
+  if (p.grid.empty()) grid->fail("must name a grid");
+  if (transform) p.transform = read_transform(*transform);
+  // A misspelt key is reported as such before the file is read with a default in its place.
+  d.finish(R"(for density type "vdb")");
+  try {
+    return make_vdb_density(p);
+  } catch (const VdbError& e) {
+    // A problem of the grid is blamed on "grid", or on the density when the default was used.
+    if (e.key != "grid") file.fail(e.what());
+    if (grid) grid->fail(e.what());
+    d.fail(e.what());
+  }
+}
+
 }  // namespace
 
 const std::vector<DensityType>& density_types() {
@@ -35,6 +65,7 @@ const std::vector<DensityType>& density_types() {
       {"constant", read_constant},
       {"field", read_field},
       {"cloud", read_cloud},
+      {"vdb", read_vdb},
   };
   return types;
 }

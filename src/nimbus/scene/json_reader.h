@@ -23,8 +23,9 @@ struct SceneError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Where a document came from, for messages. A value that a --set override put in place is
-// reported against that flag rather than against the file, which never contained it.
+// Where a document came from, for messages and relative file names. A value that a --set
+// override put in place is reported against that flag rather than against the file, which never
+// contained it.
 struct JsonOrigin {
   std::string source;
   struct Override {
@@ -32,6 +33,9 @@ struct JsonOrigin {
     std::string flag;     // "--set KEY=VALUE" as given
   };
   std::vector<Override> overrides;
+  // The folder that relative file names in the document resolve against: the scene file's own;
+  // "" (the current directory) for a document that is not a file.
+  std::string folder = "";
 };
 
 // An allowed interval for numbers; each end may be open, closed or absent.

@@ -80,6 +80,8 @@ E choice_of(const JsonValue& v, std::string_view noun,
   return table[v.choice(noun, names)].second;
 }
 
+}  // namespace
+
 Mat4 read_transform(const JsonValue& v) {
   Mat4 m = Mat4::identity();
   for (const JsonValue& step_value : v.array()) {
@@ -116,6 +118,8 @@ Mat4 read_transform(const JsonValue& v) {
     v.fail(fmt::format("degenerate transform (determinant {})", det));
   return m;
 }
+
+namespace {
 
 class Loader {
  public:
@@ -623,12 +627,24 @@ std::string apply_override(nlohmann::json& j, const std::string& key_equals_valu
   return created.value_or(pointer);
 }
 
-SceneDesc load_scene_json(nlohmann::json j, const std::string& source,
-                          const std::vector<std::string>& overrides) {
-  JsonOrigin origin{source, {}};
+namespace {
+
+// load_scene_json, with the folder that relative file names in the document resolve against
+// (a VDB density's "file"): the scene file's own, or "" (the current directory) for a document
+// that is not a file.
+SceneDesc load_json_in(nlohmann::json j, const std::string& source, const std::string& folder,
+                       const std::vector<std::string>& overrides) {
+  JsonOrigin origin{source, {}, folder};
   for (const std::string& o : overrides)
     origin.overrides.push_back({apply_override(j, o), set_flag(o)});
   return Loader(JsonValue(j, "", origin)).load();
+}
+
+}  // namespace
+
+SceneDesc load_scene_json(nlohmann::json j, const std::string& source,
+                          const std::vector<std::string>& overrides) {
+  return load_json_in(std::move(j), source, "", overrides);
 }
 
 // A parser callback that refuses a key given twice in one object (the JSON standard leaves it
@@ -689,8 +705,9 @@ class DuplicateKeys {
   std::vector<Frame> frames_;
 };
 
-SceneDesc load_scene_text(const std::string& text, const std::string& source,
-                          const std::vector<std::string>& overrides) {
+namespace {
+
+nlohmann::json parse_scene_text(const std::string& text, const std::string& source) {
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(text, DuplicateKeys(source), true, /*ignore_comments=*/true);
@@ -702,11 +719,19 @@ SceneDesc load_scene_text(const std::string& text, const std::string& source,
     throw SceneError(source + ": " +
                      (bracket == std::string::npos ? what : what.substr(bracket + 2)));
   }
-  return load_scene_json(std::move(j), source, overrides);
+  return j;
+}
+
+}  // namespace
+
+SceneDesc load_scene_text(const std::string& text, const std::string& source,
+                          const std::vector<std::string>& overrides) {
+  return load_json_in(parse_scene_text(text, source), source, "", overrides);
 }
 
 SceneDesc load_scene_file(const std::string& path, const std::vector<std::string>& overrides) {
-  return load_scene_text(read_file(path), path, overrides);
+  return load_json_in(parse_scene_text(read_file(path), path), path,
+                      std::filesystem::path(path).parent_path().string(), overrides);
 }
 
 }  // namespace nimbus

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "nimbus/math/mat4.h"
 #include "nimbus/scene/json_reader.h"
 #include "nimbus/scene/scene_desc.h"
 
@@ -33,6 +34,10 @@ SceneDesc load_scene_text(const std::string& text, const std::string& source,
 // As load_scene_file for a document already parsed; `source` names it in messages.
 SceneDesc load_scene_json(nlohmann::json j, const std::string& source,
                           const std::vector<std::string>& overrides = {});
+
+// A "transform" value (docs/scene-format.md): steps applied in the listed order; a degenerate one
+// fails. Shapes and the "vdb" density read it.
+Mat4 read_transform(const JsonValue& v);
 
 // Applies one `--set KEY=VALUE`: KEY is a dotted path into the document (array elements by
 // index, as in lights.0.radiance), VALUE is parsed as JSON or else taken as a string. Missing

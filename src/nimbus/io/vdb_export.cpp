@@ -1,0 +1,211 @@
+#include "nimbus/io/vdb_export.h"
+
+#include <fmt/format.h>
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <vector>
+
+#include "nimbus/io/atomic_file.h"
+
+namespace nimbus {
+namespace {
+
+using Leaf = openvdb::FloatTree::LeafNodeType;
+constexpr int kLeafDim = int(Leaf::DIM);  // 8
+
+// The voxel centres i H inside [lo, hi] on one axis.
+struct AxisRange {
+  long long first, last;
+};
+
+AxisRange axis_range(double lo, double hi, double h) {
+  return {static_cast<long long>(std::ceil(lo / h)), static_cast<long long>(std::floor(hi / h))};
+}
+
+long long floor_div(long long a, long long b) {
+  return a >= 0 ? a / b : -((-a + b - 1) / b);
+}
+
+// Reports progress from parallel workers, as the octree build does: whichever thread gets the
+// lock reports, rising fractions only, in steps of at least 0.1 %.
+class Progress {
+ public:
+  explicit Progress(const BuildMonitor& m) : m_(m) {}
+  void report(double fraction) {
+    if (!m_.progress) return;
+    std::unique_lock lock(mutex_, std::try_to_lock);
+    if (!lock.owns_lock() || (fraction < 1 && fraction < last_ + 1e-3)) return;
+    last_ = fraction;
+    m_.progress(fraction);
+  }
+  bool cancelled() {
+    if (!cancelled_.load(std::memory_order_relaxed) && m_.cancel && m_.cancel())
+      cancelled_.store(true, std::memory_order_relaxed);
+    return cancelled_.load(std::memory_order_relaxed);
+  }
+
+ private:
+  const BuildMonitor& m_;
+  std::mutex mutex_;
+  double last_ = -1;
+  std::atomic<bool> cancelled_{false};
+};
+
+openvdb::Vec3s to_vec3s(const Rgb& c) {
+  return openvdb::Vec3s(float(c[0]), float(c[1]), float(c[2]));
+}
+
+}  // namespace
+
+int vdb_export_object(const SceneDesc& desc, int requested) {
+  const int n = static_cast<int>(desc.objects.size());
+  if (requested < 0) {
+    for (int i = 0; i < n; ++i)
+      if (desc.objects[i].medium >= 0) return i;
+    throw std::invalid_argument(
+        fmt::format("{}: no object holds a medium: there is nothing to export", desc.source));
+  }
+  if (requested >= n)
+    throw std::invalid_argument(fmt::format("--object {}: {} has {} object{} (0 to {})", requested,
+                                            desc.source, n, n == 1 ? "" : "s", n - 1));
+  if (desc.objects[requested].medium < 0)
+    throw std::invalid_argument(fmt::format("--object {}: {}: {} holds no medium", requested,
+                                            desc.source, desc.objects[requested].json_path));
+  return requested;
+}
+
+double vdb_export_voxels(const Scene& scene, int object, double h) {
+  const Box& b = scene.objects.at(object).bounds;
+  double count = 1;
+  for (int k = 0; k < 3; ++k) {
+    const AxisRange r = axis_range(b.lo[k], b.hi[k], h);
+    count *= double(std::max(0LL, r.last - r.first + 1));
+  }
+  return count;
+}
+
+VdbExportResult export_vdb(const Scene& scene, int object, double h, const std::string& path,
+                           const BuildMonitor& monitor) {
+  if (!(h > 0) || !std::isfinite(h))
+    throw std::invalid_argument(fmt::format("--voxel-size must be > 0, not {}", h));
+  const SceneObject& obj = scene.objects.at(object);
+  if (obj.medium < 0) throw std::invalid_argument(fmt::format("object {} holds no medium", object));
+  const Medium& medium = scene.media[obj.medium];
+  const double voxels = vdb_export_voxels(scene, object, h);
+  if (voxels > kVdbExportMaxVoxels)
+    throw std::invalid_argument(fmt::format(
+        "--voxel-size {}: the object's bounds hold {:.3g} voxels, more than the {:.3g} an export "
+        "may have; use a larger voxel size",
+        h, voxels, kVdbExportMaxVoxels));
+
+  // Blocks of 8³ voxels, aligned as OpenVDB's leaves, over the voxel centres in the bounds.
+  AxisRange voxel[3], block[3];
+  long long blocks_along[3];
+  for (int k = 0; k < 3; ++k) {
+    voxel[k] = axis_range(obj.bounds.lo[k], obj.bounds.hi[k], h);
+    if (std::max(std::abs(voxel[k].first), std::abs(voxel[k].last)) > (1LL << 30))
+      throw std::invalid_argument(fmt::format(
+          "--voxel-size {}: voxel indices beyond 2^30 (the object is far from the origin); use "
+          "a larger voxel size",
+          h));
+    block[k] = {floor_div(voxel[k].first, kLeafDim), floor_div(voxel[k].last, kLeafDim)};
+    blocks_along[k] = std::max(0LL, block[k].last - block[k].first + 1);
+  }
+  const std::size_t blocks =
+      voxels > 0 ? std::size_t(blocks_along[0] * blocks_along[1] * blocks_along[2]) : 0;
+
+  Progress progress(monitor);
+  std::vector<std::unique_ptr<Leaf>> leaves(blocks);
+  std::atomic<std::size_t> done{0};
+  const Density& density = *medium.density;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks), [&](const auto& range) {
+    for (std::size_t b = range.begin(); b != range.end(); ++b) {
+      if (progress.cancelled()) return;
+      const long long bx =
+          block[0].first + static_cast<long long>(b) / (blocks_along[1] * blocks_along[2]);
+      const long long by =
+          block[1].first + static_cast<long long>(b) / blocks_along[2] % blocks_along[1];
+      const long long bz = block[2].first + static_cast<long long>(b) % blocks_along[2];
+      const long long origin[3] = {bx * kLeafDim, by * kLeafDim, bz * kLeafDim};
+      long long lo[3], hi[3];
+      Box box;
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::max(origin[k], voxel[k].first);
+        hi[k] = std::min(origin[k] + kLeafDim - 1, voxel[k].last);
+        box.lo[k] = double(lo[k]) * h;
+        box.hi[k] = double(hi[k]) * h;
+      }
+      progress.report(double(++done) / double(blocks));
+      // A block where the object's function or the density's range rules the medium out costs
+      // no lookup: sparse media export in time proportional to their volume.
+      const Interval F = evaluate(obj.tape, box);
+      if (!(F.hi > 0) || !(density.range(box, F).hi > 0)) continue;
+      auto leaf = std::make_unique<Leaf>(
+          openvdb::Coord(int(origin[0]), int(origin[1]), int(origin[2])), 0.0f);
+      bool any = false;
+      for (long long i = lo[0]; i <= hi[0]; ++i)
+        for (long long j = lo[1]; j <= hi[1]; ++j)
+          for (long long k = lo[2]; k <= hi[2]; ++k) {
+            const Vec3 x{double(i) * h, double(j) * h, double(k) * h};
+            const double f = evaluate(obj.tape, x);
+            if (!(f > 0)) continue;  // outside the object there is no medium
+            const double d = medium.scale * density.value(x, f);
+            if (!(d > 0)) continue;
+            leaf->setValueOn(openvdb::Coord(int(i), int(j), int(k)), static_cast<float>(d));
+            any = true;
+          }
+      if (any) leaves[b] = std::move(leaf);
+    }
+  });
+  VdbExportResult result;
+  if (progress.cancelled()) {
+    result.cancelled = true;
+    return result;
+  }
+  progress.report(1);
+
+  for (const auto& leaf : leaves)
+    if (leaf)
+      for (auto v = leaf->cbeginValueOn(); v; ++v)
+        result.max_density = std::max(result.max_density, double(*v));
+  if (!(result.max_density <= std::numeric_limits<float>::max()))
+    throw std::invalid_argument(fmt::format(
+        "the density reaches {}, beyond the float range of a VDB grid", result.max_density));
+  // Below the threshold voxels go inactive (and 0), and leaves left without active voxels go.
+  const float threshold = static_cast<float>(kVdbExportThreshold * result.max_density);
+  openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
+  for (auto& leaf : leaves) {
+    if (!leaf) continue;
+    for (auto v = leaf->beginValueOn(); v; ++v)
+      if (*v < threshold) leaf->setValueOff(v.pos(), 0.0f);
+    if (!leaf->isEmpty()) grid->tree().addLeaf(leaf.release());
+  }
+  result.active_voxels = grid->activeVoxelCount();
+
+  openvdb::initialize();
+  grid->setName("density");
+  grid->setGridClass(openvdb::GRID_FOG_VOLUME);
+  grid->setTransform(openvdb::math::Transform::createLinearTransform(h));
+  grid->insertMeta("sigma_a", openvdb::Vec3SMetadata(to_vec3s(medium.sigma_a.rgb)));
+  grid->insertMeta("sigma_s", openvdb::Vec3SMetadata(to_vec3s(medium.sigma_s.rgb)));
+  grid->insertMeta("phase_g", openvdb::FloatMetadata(float(medium.g)));
+  openvdb::MetaMap file_meta;
+  file_meta.insertMeta("creator", openvdb::StringMetadata("nimbus " NIMBUS_VERSION));
+  write_atomically(path, [&](const std::string& temp) {
+    openvdb::io::File file(temp);
+    file.write({grid}, file_meta);
+    file.close();
+  });
+  return result;
+}
+
+}  // namespace nimbus

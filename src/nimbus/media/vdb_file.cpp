@@ -1,0 +1,264 @@
+#include "nimbus/media/vdb_file.h"
+
+// First: Debian's nanovdb/util/GridValidator.h uses std::cerr without including <iostream>.
+#include <iostream>
+// Then the libraries and the standard library.
+
+#include <fmt/format.h>
+#include <nanovdb/NanoVDB.h>
+#include <nanovdb/util/GridHandle.h>
+#include <nanovdb/util/GridValidator.h>
+#include <nanovdb/util/IO.h>
+#include <nanovdb/util/NanoToOpenVDB.h>
+#include <nanovdb/util/OpenToNanoVDB.h>
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <vector>
+
+#include "nimbus/media/vdb_density.h"
+
+namespace nimbus {
+namespace {
+
+namespace fs = std::filesystem;
+
+[[noreturn]] void fail_file(const std::string& file, const std::string& problem) {
+  throw VdbError("file", fmt::format("{}: {}", file, problem));
+}
+
+[[noreturn]] void fail_grid(const std::string& file, const std::string& grid,
+                            const std::string& problem) {
+  throw VdbError("grid", fmt::format("{}: grid \"{}\" {}", file, grid, problem));
+}
+
+// "the file holds grids "a", "b"" or "the file holds no grid".
+std::string holds(const std::vector<std::string>& names) {
+  if (names.empty()) return "the file holds no grid";
+  std::string list;
+  for (const std::string& n : names) list += fmt::format("{}\"{}\"", list.empty() ? "" : ", ", n);
+  return fmt::format("the file holds {} {}", names.size() == 1 ? "grid" : "grids", list);
+}
+
+enum class Format { OpenVdb, NanoVdb };
+
+// Only a regular file that starts with either library's magic number is handed to a library: a
+// directory, a FIFO or a text file is one line here, and neither reader sees it.
+Format sniff(const std::string& file) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(file, ec);
+  if (!fs::exists(st))
+    fail_file(file, fmt::format("cannot open file ({})",
+                                ec ? ec.message() : std::string("No such file or directory")));
+  if (fs::is_directory(st)) fail_file(file, "cannot open file (is a directory)");
+  if (!fs::is_regular_file(st)) fail_file(file, "not a regular file");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) fail_file(file, fmt::format("cannot open file ({})", std::strerror(errno)));
+  unsigned char head[8] = {};
+  in.read(reinterpret_cast<char*>(head), sizeof head);
+  const std::streamsize got = in.gcount();
+  std::uint64_t magic64 = 0;
+  std::int32_t magic32 = 0;
+  std::memcpy(&magic64, head, sizeof magic64);
+  std::memcpy(&magic32, head, sizeof magic32);
+  if (got == 8 && magic64 == NANOVDB_MAGIC_NUMBER) return Format::NanoVdb;
+  if (got >= 4 && magic32 == openvdb::OPENVDB_MAGIC) return Format::OpenVdb;
+  fail_file(file, "not a VDB file (it starts with neither OpenVDB's nor NanoVDB's magic number)");
+}
+
+// The grid as a density reads it, in a new float grid with background 0: active values copied
+// (negative ones as 0), inactive voxels and tiles 0, leaves without active voxels dropped, so that
+// every node left holds active values and its extrema are those range() needs.
+template <class GridT>
+openvdb::FloatGrid::Ptr cleaned(const GridT& in, const std::string& file, const std::string& name) {
+  openvdb::FloatGrid::Ptr out = openvdb::FloatGrid::create(0.0f);
+  out->setTransform(in.transform().copy());
+  openvdb::FloatTree& tree = out->tree();
+  const auto density = [&](double v, const openvdb::Coord& at) {
+    const float f = static_cast<float>(std::max(v, 0.0));
+    if (!std::isfinite(v) || !std::isfinite(f))
+      fail_grid(file, name,
+                fmt::format("holds the value {} at voxel ({}, {}, {}); a density must be finite", v,
+                            at.x(), at.y(), at.z()));
+    return f;
+  };
+  for (auto leaf = in.tree().cbeginLeaf(); leaf; ++leaf) {
+    if (leaf->isEmpty()) continue;
+    auto copy = std::make_unique<openvdb::FloatTree::LeafNodeType>(leaf->origin(), 0.0f);
+    for (auto v = leaf->cbeginValueOn(); v; ++v)
+      copy->setValueOn(v.pos(), density(*v, v.getCoord()));
+    tree.addLeaf(copy.release());
+  }
+  for (auto tile = in.tree().cbeginValueOn(); tile; ++tile)
+    if (!tile.isVoxelValue())
+      tree.addTile(tile.getLevel(), tile.getCoord(), density(*tile, tile.getCoord()), true);
+  return out;
+}
+
+// The checks that need only the grid's metadata: a float or double fog volume with a linear
+// transform.
+void check_grid(const openvdb::GridBase& g, const std::string& file, const std::string& name) {
+  if (!g.isType<openvdb::FloatGrid>() && !g.isType<openvdb::DoubleGrid>())
+    fail_grid(
+        file, name,
+        fmt::format("holds {} values; a density grid holds float or double values", g.valueType()));
+  if (g.getGridClass() == openvdb::GRID_LEVEL_SET)
+    fail_grid(file, name,
+              "is a level set (signed distances), not a density; convert it to a fog volume "
+              "first (OpenVDB's tools::sdfToFogVolume)");
+  if (!g.transform().isLinear())
+    fail_grid(file, name,
+              fmt::format("has a non-linear transform ({}); only linear (affine) grid "
+                          "transforms are supported",
+                          g.transform().mapType()));
+}
+
+openvdb::FloatGrid::Ptr read_openvdb(const std::string& file, const std::string& name) {
+  openvdb::io::File f(file);
+  try {
+    f.open(/*delayLoad=*/false);
+  } catch (const std::exception& e) {
+    fail_file(file, fmt::format("not a readable OpenVDB file ({})", e.what()));
+  }
+  std::vector<std::string> names;
+  for (auto it = f.beginName(); it != f.endName(); ++it) names.push_back(*it);
+  if (!f.hasGrid(name)) fail_grid(file, name, fmt::format("is not in the file ({})", holds(names)));
+  check_grid(*f.readGridMetadata(name), file, name);
+  const openvdb::GridBase::Ptr grid = f.readGrid(name);
+  f.close();
+  if (const auto g = openvdb::gridConstPtrCast<openvdb::FloatGrid>(grid))
+    return cleaned(*g, file, name);
+  return cleaned(*openvdb::gridConstPtrCast<openvdb::DoubleGrid>(grid), file, name);
+}
+
+// Whether every node of a NanoVDB grid lies inside its buffer, 32-byte aligned: a corrupted file
+// could otherwise send the conversion through wild offsets. (NanoVDB's own GridValidator skips
+// the leaves.)
+template <class T>
+bool nano_nodes_inside(const nanovdb::NanoGrid<T>& grid, std::uint64_t size) {
+  const auto base = reinterpret_cast<std::uintptr_t>(&grid);
+  const auto inside = [&](const void* p, std::uint64_t bytes) {
+    const auto at = reinterpret_cast<std::uintptr_t>(p);
+    return at >= base && bytes <= size && at - base <= size - bytes &&
+           at % NANOVDB_DATA_ALIGNMENT == 0;
+  };
+  if (grid.gridSize() > size || !inside(&grid.tree(), sizeof(grid.tree()))) return false;
+  const auto& root = grid.tree().root();
+  if (!inside(&root, sizeof(root)) || !inside(&root, root.memUsage())) return false;
+  for (std::uint32_t i = 0; i < root.tileCount(); ++i) {
+    const auto* tile = root.data()->tile(i);
+    if (!tile->isChild()) continue;
+    const auto* upper = root.data()->getChild(tile);
+    if (!inside(upper, sizeof(*upper))) return false;
+    for (auto n = upper->childMask().beginOn(); n; ++n) {
+      const auto* lower = upper->data()->getChild(*n);
+      if (!inside(lower, sizeof(*lower))) return false;
+      for (auto m = lower->childMask().beginOn(); m; ++m)
+        if (!inside(lower->data()->getChild(*m), sizeof(nanovdb::NanoLeaf<T>))) return false;
+    }
+  }
+  return true;
+}
+
+template <class T>
+openvdb::FloatGrid::Ptr nano_to_cleaned(const nanovdb::GridHandle<>& handle,
+                                        const std::string& file, const std::string& name) {
+  const nanovdb::NanoGrid<T>* grid = handle.grid<T>();
+  if (!grid) fail_file(file, fmt::format("grid \"{}\" could not be read (corrupted file)", name));
+  if (!nano_nodes_inside(*grid, handle.size()))
+    fail_file(file, "corrupted NanoVDB file (a node lies outside its grid)");
+  if (const std::string problem = nanovdb::GridValidator<T>::check(*grid, /*detailed=*/false);
+      !problem.empty())
+    fail_file(file, fmt::format("corrupted NanoVDB file ({})", problem));
+  const auto open = nanovdb::nanoToOpenVDB(*grid);
+  check_grid(*open, file, name);
+  return cleaned(*open, file, name);
+}
+
+openvdb::FloatGrid::Ptr read_nanovdb(const std::string& file, const std::string& name) {
+  std::vector<nanovdb::io::GridMetaData> grids;
+  try {
+    grids = nanovdb::io::readGridMetaData(file);
+  } catch (const std::exception& e) {
+    fail_file(file, fmt::format("not a readable NanoVDB file ({})", e.what()));
+  }
+  std::vector<std::string> names;
+  const nanovdb::io::GridMetaData* meta = nullptr;
+  for (const auto& g : grids) {
+    names.push_back(g.gridName);
+    if (g.gridName == name && !meta) meta = &g;
+  }
+  if (!meta) fail_grid(file, name, fmt::format("is not in the file ({})", holds(names)));
+  const nanovdb::GridType type = meta->gridType;
+  if (type != nanovdb::GridType::Float && type != nanovdb::GridType::Double)
+    fail_grid(file, name,
+              fmt::format("holds {} values; a density grid holds float or double values",
+                          nanovdb::toStr(type)));
+  if (meta->gridClass == nanovdb::GridClass::LevelSet)
+    fail_grid(file, name,
+              "is a level set (signed distances), not a density; convert it to a fog volume "
+              "first");
+  if (meta->codec != nanovdb::io::Codec::NONE)
+    fail_file(file, fmt::format("grid \"{}\" is compressed ({}); nimbus reads uncompressed .nvdb "
+                                "files (nanovdb_convert without -z or -b)",
+                                name, nanovdb::io::toStr(meta->codec)));
+  std::error_code ec;
+  if (meta->gridSize > fs::file_size(file, ec) || ec)
+    fail_file(file, "corrupted NanoVDB file (a grid is larger than the file)");
+  nanovdb::GridHandle<> handle;
+  try {
+    handle = nanovdb::io::readGrid(file, name);
+  } catch (const std::exception& e) {
+    fail_file(file, fmt::format("corrupted NanoVDB file ({})", e.what()));
+  }
+  return type == nanovdb::GridType::Float ? nano_to_cleaned<float>(handle, file, name)
+                                          : nano_to_cleaned<double>(handle, file, name);
+}
+
+// The affine map from index space to the grid's world space, from the images of the origin and
+// the unit vectors (OpenVDB's matrices act on row vectors; this avoids depending on that).
+Mat4 world_from_index(const openvdb::math::Transform& t) {
+  const openvdb::Vec3d o = t.indexToWorld(openvdb::Vec3d(0, 0, 0));
+  Mat4 m = Mat4::identity();
+  for (int c = 0; c < 3; ++c) {
+    openvdb::Vec3d e(0, 0, 0);
+    e[c] = 1;
+    const openvdb::Vec3d image = t.indexToWorld(e) - o;
+    for (int r = 0; r < 3; ++r) m(r, c) = image[r];
+  }
+  for (int r = 0; r < 3; ++r) m(r, 3) = o[r];
+  return m;
+}
+
+}  // namespace
+
+VdbFileGrid read_vdb_file(const std::string& file, const std::string& name) {
+  openvdb::initialize();  // registers the grid types; cheap after the first call
+  const Format format = sniff(file);
+  openvdb::FloatGrid::Ptr grid;
+  try {
+    grid = format == Format::OpenVdb ? read_openvdb(file, name) : read_nanovdb(file, name);
+  } catch (const VdbError&) {
+    throw;
+  } catch (const std::exception& e) {
+    // Past the header, a library's exception means data it could not decode.
+    fail_file(file, fmt::format("corrupted {} file ({})",
+                                format == Format::OpenVdb ? "OpenVDB" : "NanoVDB", e.what()));
+  }
+  auto handle = std::make_shared<nanovdb::GridHandle<>>(
+      nanovdb::openToNanoVDB(*grid, nanovdb::StatsMode::MinMax, nanovdb::ChecksumMode::Disable));
+  VdbFileGrid out;
+  out.grid = handle->grid<float>();
+  out.owner = std::move(handle);
+  out.world_from_index = world_from_index(grid->transform());
+  out.active_voxels = grid->activeVoxelCount();
+  return out;
+}
+
+}  // namespace nimbus

@@ -1,0 +1,25 @@
+#pragma once
+// Reading one float grid from a .vdb (OpenVDB) or .nvdb (NanoVDB) file into NanoVDB's layout,
+// cleaned for use as a density (vdb_density.h). The grid comes back type-erased so that this
+// header, which is installed, names no OpenVDB or NanoVDB type: only vdb_file.cpp and
+// vdb_density.cpp include those libraries.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "nimbus/math/mat4.h"
+
+namespace nimbus {
+
+struct VdbFileGrid {
+  std::shared_ptr<const void> owner;  // keeps the grid's memory (a NanoVDB grid handle) alive
+  const void* grid = nullptr;         // the nanovdb::NanoGrid<float> in it
+  Mat4 world_from_index;              // the grid's own transform (affine)
+  std::uint64_t active_voxels = 0;
+};
+
+// Throws VdbError (vdb_density.h) for every way the file or grid can be unusable.
+VdbFileGrid read_vdb_file(const std::string& file, const std::string& grid);
+
+}  // namespace nimbus
