@@ -10,7 +10,6 @@
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <mutex>
 #include <stdexcept>
 #include <vector>
 
@@ -34,31 +33,6 @@ AxisRange axis_range(double lo, double hi, double h) {
 long long floor_div(long long a, long long b) {
   return a >= 0 ? a / b : -((-a + b - 1) / b);
 }
-
-// Reports progress from parallel workers, as the octree build does: whichever thread gets the
-// lock reports, rising fractions only, in steps of at least 0.1 %.
-class Progress {
- public:
-  explicit Progress(const BuildMonitor& m) : m_(m) {}
-  void report(double fraction) {
-    if (!m_.progress) return;
-    std::unique_lock lock(mutex_, std::try_to_lock);
-    if (!lock.owns_lock() || (fraction < 1 && fraction < last_ + 1e-3)) return;
-    last_ = fraction;
-    m_.progress(fraction);
-  }
-  bool cancelled() {
-    if (!cancelled_.load(std::memory_order_relaxed) && m_.cancel && m_.cancel())
-      cancelled_.store(true, std::memory_order_relaxed);
-    return cancelled_.load(std::memory_order_relaxed);
-  }
-
- private:
-  const BuildMonitor& m_;
-  std::mutex mutex_;
-  double last_ = -1;
-  std::atomic<bool> cancelled_{false};
-};
 
 openvdb::Vec3s to_vec3s(const Rgb& c) {
   return openvdb::Vec3s(float(c[0]), float(c[1]), float(c[2]));
@@ -123,7 +97,7 @@ VdbExportResult export_vdb(const Scene& scene, int object, double h, const std::
   const std::size_t blocks =
       voxels > 0 ? std::size_t(blocks_along[0] * blocks_along[1] * blocks_along[2]) : 0;
 
-  Progress progress(monitor);
+  BuildWatch progress(monitor);
   std::vector<std::unique_ptr<Leaf>> leaves(blocks);
   std::atomic<std::size_t> done{0};
   const Density& density = *medium.density;

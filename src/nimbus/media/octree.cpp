@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <mutex>
 
 #include "nimbus/math/rng.h"
 #include "nimbus/media/medium_field.h"
@@ -201,33 +200,6 @@ void floor_sampled_bounds(double lo, double hi, double& mu_bar, double& mu_c) {
 // The paper's preliminary pass: min and max of mu_t at random points of each non-empty leaf,
 // per bin (in spectral mode from each medium's sigma_t bounds over the bin). Interior nodes then
 // hold the hull of their children.
-// Reports a build's progress from parallel workers: whichever thread gets the lock reports, the
-// others go on; cancellation is polled the same way.
-class Watch {
- public:
-  explicit Watch(const BuildMonitor& m) : m_(m) {}
-  // Fractions that arrive out of order (a slower thread) are dropped, so the reports rise, and
-  // steps below 0.1 % are not worth a report (a deep tree has 10^5 leaves).
-  void report(double fraction) {
-    if (!m_.progress) return;
-    std::unique_lock lock(mutex_, std::try_to_lock);
-    if (!lock.owns_lock() || (fraction < 1 && fraction < last_ + 1e-3)) return;
-    last_ = fraction;
-    m_.progress(fraction);
-  }
-  bool cancelled() {
-    if (!cancelled_.load(std::memory_order_relaxed) && m_.cancel && m_.cancel())
-      cancelled_.store(true, std::memory_order_relaxed);
-    return cancelled_.load(std::memory_order_relaxed);
-  }
-
- private:
-  const BuildMonitor& m_;
-  std::mutex mutex_;
-  double last_ = -1;
-  std::atomic<bool> cancelled_{false};
-};
-
 // The members as the media layer's point lookup wants them (media_scene.h).
 struct MemberObject {
   const Tape& tape;
@@ -244,7 +216,7 @@ struct MemberScene {
 // done as the second.
 void sample_bounds(const MemberScene& scene, int inside, const OctreeSettings& settings,
                    const std::vector<std::vector<double>>& sigma_t, MajorantOctree& tree, Grown& g,
-                   Watch& watch) {
+                   BuildWatch& watch) {
   // At most kOctreeSampleBudget points in all: a deep tree gets fewer per leaf (at depth 16 with
   // 4 096 per leaf the pass had not finished after 60 s).
   size_t leaves = 0;
@@ -311,7 +283,7 @@ MajorantOctree build_majorant_octree(std::span<const Medium> media,
                                      std::span<const OctreeMember> holders, bool solid,
                                      const OctreeSettings& settings, const BuildMonitor& monitor) {
   const auto start = std::chrono::steady_clock::now();
-  Watch watch(monitor);
+  BuildWatch watch(monitor);
   MajorantOctree tree;
   tree.bins = settings.spectral ? kSpectralBins : 3;
   tree.majorant_scale = settings.majorant_scale;

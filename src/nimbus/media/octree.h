@@ -27,7 +27,6 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <functional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -35,6 +34,7 @@
 #include "nimbus/frep/tape.h"
 #include "nimbus/math/box.h"
 #include "nimbus/math/ray.h"
+#include "nimbus/media/build_monitor.h"
 #include "nimbus/media/medium.h"
 #include "nimbus/spectral/spectrum.h"
 
@@ -100,15 +100,6 @@ struct OctreeMember {
   const Tape* tape;
   Box bounds;
   int medium;
-};
-
-// Watches a build that may take seconds (deep trees, sampled bounds, costly densities). Both are
-// optional; progress is called from one thread at a time with the fraction done, ending with 1
-// for a build that finishes. Once cancel returns true the build stops early and returns a tree
-// that must not be used.
-struct BuildMonitor {
-  std::function<void(double)> progress;
-  std::function<bool()> cancel;
 };
 
 // The octree over `members`' media: inside one solid object (`solid`: one member, whose medium
