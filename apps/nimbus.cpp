@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <string>
 #include <thread>
@@ -81,6 +82,15 @@ void print_progress(const char* what, double fraction, double elapsed) {
                std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
                100 * fraction, elapsed, eta);
   std::fflush(stderr);
+}
+
+// A progress callback that draws `what`'s bar, timed from when it is made.
+std::function<void(double)> progress_bar(const char* what) {
+  const auto start = std::chrono::steady_clock::now();
+  return [what, start](double f) {
+    print_progress(what, f,
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  };
 }
 
 // Refuses, with one line and exit 2, a render that the machine (or --max-memory) cannot hold,
@@ -153,13 +163,7 @@ int run_render(const RenderArgs& args) {
   // bar of their own, and a signal stops them too.
   BuildMonitor monitor;
   monitor.cancel = [] { return g_signal.load() != 0; };
-  const auto build_start = std::chrono::steady_clock::now();
-  if (show_progress)
-    monitor.progress = [&](double f) {
-      print_progress(
-          "octrees", f,
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - build_start).count());
-    };
+  if (show_progress) monitor.progress = progress_bar("octrees");
   Scene scene;
   try {
     scene = compile_scene(desc, monitor);
@@ -179,13 +183,7 @@ int run_render(const RenderArgs& args) {
   RenderOptions options;
   options.threads = args.threads;
   options.cancel = [] { return g_signal.load() != 0; };
-  const auto start = std::chrono::steady_clock::now();
-  if (show_progress)
-    options.progress = [&](double f) {
-      print_progress(
-          "render", f,
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-    };
+  if (show_progress) options.progress = progress_bar("render");
   const RenderResult result = render(scene, options);
   if (show_progress) std::fprintf(stderr, "\n");
   if (const int sig = g_signal.load(); sig != 0) {
