@@ -45,6 +45,7 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
       {"majorant_segments", c.majorant_segments},
       {"mean_scatter_events_per_path", c.paths ? double(c.scatter_events) / c.paths : 0.0},
       {"clamped_probabilities", c.tracking.clamped},
+      {"raised_majorants", c.tracking.raised},
       {"null_collision_fraction",
        c.tracking.tentative_collisions
            ? double(c.null_collisions()) / double(c.tracking.tentative_collisions)

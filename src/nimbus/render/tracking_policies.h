@@ -47,7 +47,7 @@ class PlainTracking {
 
   MediumEvent<N> collide(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray, double t_max,
                          int inside, Rng& rng, Counters& counters) {
-    return sample_collision(scene, ps, ray, t_max, inside, beta_, channel_, rng, counters);
+    return sample_collision(scene, ps, ray, t_max, inside, beta_, channel_, boost_, rng, counters);
   }
 
   // Next-event estimation of one light sample `ls` along `shadow` (to t_max): fLi is the
@@ -58,7 +58,7 @@ class PlainTracking {
                   int light, int inside, const LightSample& ls, const Spectrum<N>& fLi, Pdf&& f_pdf,
                   Rng& rng, Counters& counters, Spectrum<N>& out) const {
     const Spectrum<N> T =
-        transmittance(scene, ps, shadow, t_max, light, inside, channel_, rng, counters);
+        transmittance(scene, ps, shadow, t_max, light, inside, channel_, boost_, rng, counters);
     if (T.is_black()) return false;
     out = ls.delta ? fLi * T : fLi * T * (power_heuristic(ls.pdf, f_pdf(ls.wi)) / ls.pdf);
     return true;
@@ -89,6 +89,7 @@ class PlainTracking {
   // medium (sample_collision), and from then on carries its weight (times N) in that channel.
   int channel_ = -1;
   double prev_pdf_ = 0;  // solid-angle pdf with which the current direction was sampled
+  double boost_ = 1;     // the path's majorant boost (volume.h)
 };
 
 template <int N>
@@ -100,7 +101,7 @@ class HeroTracking {
 
   MediumEvent<N> collide(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray, double t_max,
                          int inside, Rng& rng, Counters& counters) {
-    return sample_collision_mis(scene, ps, ray, t_max, inside, hero_, path_, rng, counters);
+    return sample_collision_mis(scene, ps, ray, t_max, inside, hero_, path_, boost_, rng, counters);
   }
 
   // Miller et al. 2019, §6 (pbrt-v4's SampleLd): the shadow ray's T_ray, r_u and r_l from hero
@@ -113,7 +114,8 @@ class HeroTracking {
                   int light, int inside, const LightSample& ls, const Spectrum<N>& fLi, Pdf&& f_pdf,
                   Rng& rng, Counters& counters, Spectrum<N>& out) const {
     MisPath<N> s;
-    if (!transmittance_mis(scene, ps, shadow, t_max, light, inside, hero_, s, rng, counters))
+    if (!transmittance_mis(scene, ps, shadow, t_max, light, inside, hero_, boost_, s, rng,
+                           counters))
       return false;
     const Spectrum<N>& r_p = path_.r_u;
     if (ls.delta) {
@@ -148,6 +150,7 @@ class HeroTracking {
  private:
   int hero_;
   MisPath<N> path_;
+  double boost_ = 1;  // the path's majorant boost (volume.h)
 };
 
 }  // namespace nimbus

@@ -28,6 +28,15 @@ struct MediumEvent {
   Spectrum<N> emitted{0.0};  // radiance emitted by the media on the way, weighted by the path
 };
 
+// A path's majorant boost: the factor on every majorant its free flights and shadow rays track
+// with. An estimator that finds mu_t above its majorant raises it for the rest of that segment
+// (tracking/free_flight.h, raise_majorant); where that happens the path's boost is multiplied by
+// kBoostOnRaise, so that later rays of the same path do not pay again where the majorants fail
+// by a factor (a majorant scale below 1, a sampled majorant that missed the maximum): the
+// boost stops growing once the boosted majorants bound. Boosts depend only on the path itself,
+// never on other samples, so images stay the same whatever the threads or processes.
+inline constexpr double kBoostOnRaise = 2;
+
 namespace volume_detail {
 
 template <int N>
@@ -75,10 +84,11 @@ MediumEvent<N> real_event(const Collision& c, const MediumPoint<N>& at, Counters
 // delta: one channel per path; `channel` -1 means none is chosen yet: where the ray meets a
 // medium one is drawn uniformly and returned, and beta keeps that channel only (times N).
 // spectral-max, spectral-history: every channel along one free path; `channel` is unused.
+// `boost` is the path's majorant boost (kBoostOnRaise), grown here where a majorant failed.
 template <int N>
 MediumEvent<N> sample_collision(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray,
-                                double t_max, int inside, Spectrum<N>& beta, int& channel, Rng& rng,
-                                Counters& counters) {
+                                double t_max, int inside, Spectrum<N>& beta, int& channel,
+                                double& boost, Rng& rng, Counters& counters) {
   using Mode = TrackingSettings::Mode;
   const TrackingSettings& ts = scene.settings.tracking;
   const bool delta = ts.mode == Mode::Delta;
@@ -103,7 +113,8 @@ MediumEvent<N> sample_collision(const Scene& scene, const PathSpectra<N>& ps, co
       beta[channel] = N * b;
     }
     policy.channel = std::max(channel, 0);
-    const double mu_bar = delta ? seg.mu_bar[channel] : seg.mu_bar.max();
+    const double mu_bar = boost * (delta ? seg.mu_bar[channel] : seg.mu_bar.max());
+    const uint64_t raised = counters.tracking.raised;
     Collision c;
     if (woodcock) {
       c = delta_tracking<N>(lookup, seg.t0, seg.t1, mu_bar, channel, rng, counters.tracking);
@@ -116,6 +127,7 @@ MediumEvent<N> sample_collision(const Scene& scene, const PathSpectra<N>& ps, co
       c = spectral_tracking<N>(lookup, seg.t0, seg.t1, mu_bar, policy, beta, emitted, rng,
                                counters.tracking);
     }
+    if (counters.tracking.raised != raised) boost *= kBoostOnRaise;
     if (c.event == CollisionEvent::Escape) return true;
     ev = volume_detail::real_event(c, lookup.last, counters);
     return false;
@@ -124,18 +136,21 @@ MediumEvent<N> sample_collision(const Scene& scene, const PathSpectra<N>& ps, co
   return ev;
 }
 
-// spectral-mis: the next real collision with hero channel `hero`, updating beta, r_u and r_l.
+// spectral-mis: the next real collision with hero channel `hero`, updating beta, r_u and r_l, and
+// the path's majorant boost.
 template <int N>
 MediumEvent<N> sample_collision_mis(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray,
-                                    double t_max, int inside, int hero, MisPath<N>& path, Rng& rng,
-                                    Counters& counters) {
+                                    double t_max, int inside, int hero, MisPath<N>& path,
+                                    double& boost, Rng& rng, Counters& counters) {
   volume_detail::RayLookup<N> lookup{scene, ps, ray, inside, {}};
   Spectrum<N> emitted(0.0);
   MediumEvent<N> ev;
   walk_majorant_segments(scene, ps.ch, ray, 0, t_max, inside, [&](const MajorantSegment<N>& seg) {
     ++counters.majorant_segments;
-    const Collision c = hero_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_bar, hero, path, emitted,
-                                         rng, counters.tracking);
+    const uint64_t raised = counters.tracking.raised;
+    const Collision c = hero_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_bar * boost, hero, path,
+                                         emitted, rng, counters.tracking);
+    if (counters.tracking.raised != raised) boost *= kBoostOnRaise;
     if (c.event == CollisionEvent::Escape) return true;
     ev = volume_detail::real_event(c, lookup.last, counters);
     return false;
@@ -149,10 +164,10 @@ MediumEvent<N> sample_collision_mis(const Scene& scene, const PathSpectra<N>& ps
 // block), or -1. `channel` >= 0 (delta tracking once it has chosen its channel): the path's
 // throughput is in that channel alone, so only it is tracked, at its own majorant, with
 // roulette on its own estimate; the other channels come back 0. -1: every channel, at the
-// largest majorant.
+// largest majorant. The majorants are multiplied by the path's `boost`.
 template <int N>
 Spectrum<N> transmittance(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray,
-                          double t_max, int light, int inside, int channel, Rng& rng,
+                          double t_max, int light, int inside, int channel, double boost, Rng& rng,
                           Counters& counters) {
   ++counters.shadow_rays;
   if (occluded(scene, ray, t_max, light)) return Spectrum<N>(0.0);
@@ -170,12 +185,12 @@ Spectrum<N> transmittance(const Scene& scene, const PathSpectra<N>& ps, const Ra
     if (residual) {
       // The residual's rate must bound |mu_t − mu_c|; a scaled majorant may fall below mu_c.
       Spectrum<N> gap;
-      for (int c = 0; c < N; ++c) gap[c] = std::abs(seg.mu_bar[c] - seg.mu_c[c]);
+      for (int c = 0; c < N; ++c) gap[c] = std::abs(boost * seg.mu_bar[c] - seg.mu_c[c]);
       T = residual_ratio_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_c, tracked_max(gap), rng,
                                      counters.tracking, T);
     } else {
-      T = ratio_tracking<N>(lookup, seg.t0, seg.t1, tracked_max(seg.mu_bar), rng, counters.tracking,
-                            T);
+      T = ratio_tracking<N>(lookup, seg.t0, seg.t1, boost * tracked_max(seg.mu_bar), rng,
+                            counters.tracking, T);
     }
     return !T.is_black();
   });
@@ -186,7 +201,7 @@ Spectrum<N> transmittance(const Scene& scene, const PathSpectra<N>& ps, const Ra
 // tracking. False if a surface blocks the way or T_ray became 0.
 template <int N>
 bool transmittance_mis(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray, double t_max,
-                       int light, int inside, int hero, MisPath<N>& path, Rng& rng,
+                       int light, int inside, int hero, double boost, MisPath<N>& path, Rng& rng,
                        Counters& counters) {
   ++counters.shadow_rays;
   if (occluded(scene, ray, t_max, light)) return false;
@@ -196,7 +211,7 @@ bool transmittance_mis(const Scene& scene, const PathSpectra<N>& ps, const Ray& 
   bool reaches = true;
   walk_majorant_segments(scene, ps.ch, ray, 0, t_max, inside, [&](const MajorantSegment<N>& seg) {
     ++counters.majorant_segments;
-    reaches = hero_ratio_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_bar, hero, path, rng,
+    reaches = hero_ratio_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_bar * boost, hero, path, rng,
                                      counters.tracking);
     return reaches;
   });

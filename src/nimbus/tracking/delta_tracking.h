@@ -8,8 +8,9 @@
 // mu_t(t) exp(−∫_{t0}^t mu_t) and the escape probability exp(−∫_{t0}^{t1} mu_t), provided mu_bar
 // bounds mu_t[c]. Where it does not (mu_n < 0), this estimator cannot represent the negative
 // null probability: it clamps (P_a, P_s) to (mu_a, mu_s)/mu_t, counts the point in
-// `counters.clamped`, and is biased from then on (free paths too long). Use it only with
-// bounding majorants; the count says when that was violated.
+// `counters.clamped`, and is biased there (free paths too long); the rest of the segment is then
+// tracked with a raised majorant (raise_majorant), so the bias stays at that one collision. Use
+// it with bounding majorants; the counts say when that was violated.
 
 #include "nimbus/math/rng.h"
 #include "nimbus/tracking/counters.h"
@@ -44,6 +45,7 @@ Collision delta_tracking(Lookup&& lookup, double t0, double t1, double mu_bar, i
                                  c = {CollisionEvent::Absorb, t};
                                else if (u < P_a + P_s)
                                  c = {CollisionEvent::Scatter, t};
+                               raise_majorant(mu_bar, mu_a + mu_s, counters);
                                return c.event == CollisionEvent::Escape;
                              });
   return c;

@@ -9,21 +9,20 @@
 // Along a majorant segment of per-channel rates mu_maj, with T_maj = exp(−mu_maj Δt) since the
 // last tentative collision (eq. numbers from Miller et al.):
 //   scatter  pdf = T_maj[h] mu_s[h] b[h]:  beta *= T_maj mu_s / pdf,  r_u *= T_maj mu_s b / pdf
-//   null     pdf = T_maj[h] mu_n[h]:  beta *= T_maj mu_n / pdf,  r_u *= T_maj max(0, mu_n) / pdf,
-//            r_l *= T_maj mu_maj / pdf
+//   null     pdf = T_maj[h] |mu_n[h]| b[h]:  beta *= T_maj mu_n / pdf,
+//            r_u *= T_maj |mu_n| b / pdf,  r_l *= T_maj mu_maj / pdf
 //   escape   beta, r_u, r_l *= T_maj / T_maj[h]
 //   emission scored at every tentative collision: beta T_maj/pdf mu_a L_e / avg(r_u mu_maj
 //   T_maj/pdf)
 //            with pdf = T_maj[h] mu_maj[h]
-// with b = mu_maj / max(mu_maj, mu_t). The hero's events are drawn with P_* = mu_*[h] b[h] /
-// mu_maj[h], P_n = 1 − P_a − P_s: where the majorant bounds, P_a = mu_a/mu_maj,
-// P_s = mu_s/mu_maj, P_n = mu_n/mu_maj; where it does not
-// (mu_n = mu_maj − mu_t < 0), P_n = 0 and absorption and scattering share 1. Each channel's r_u
-// uses that channel's own probabilities (its technique cannot sample a null event where its
-// majorant fails), while beta carries the signed mu_n. So the estimate stays unbiased as long as
-// one channel's majorant bounds mu_t at each tentative collision (that channel's technique then
-// covers the null events the others cannot sample); where none does, the collision is counted in
-// `counters.clamped`. Shadow rays are always unbiased: their light pdf r_l never vanishes.
+// with b = 1 where the channel's majorant bounds mu_t and mu_maj / (mu_a + mu_s + |mu_n|) where
+// it does not (failing_share). The hero's events are drawn with P_* = |mu_*[h]| b[h] / mu_maj[h]:
+// where the majorant bounds, P_a = mu_a/mu_maj, P_s = mu_s/mu_maj, P_n = mu_n/mu_maj; where it
+// does not (mu_n = mu_maj − mu_t < 0), the three in proportion to |mu_*|, as in the weighted
+// trackers, so every channel's technique can still sample a null event and beta carries the
+// signed mu_n: the estimate is unbiased for any positive majorants. A majorant that fails is
+// raised for the rest of the segment (raise_majorants). Shadow rays are always unbiased: their
+// light pdf r_l never vanishes.
 
 #include <algorithm>
 #include <cmath>
@@ -42,10 +41,35 @@ struct MisPath {
 };
 
 template <int N>
-Spectrum<N> clamp_zero(const Spectrum<N>& s) {
+Spectrum<N> abs_of(const Spectrum<N>& s) {
   Spectrum<N> r;
-  for (int i = 0; i < N; ++i) r[i] = std::max(0.0, s[i]);
+  for (int i = 0; i < N; ++i) r[i] = std::abs(s[i]);
   return r;
+}
+
+// b per channel: 1 where the channel's majorant bounds mu_t; where it fails (mu_n < 0), the
+// factor mu_maj / (mu_a + mu_s + |mu_n|) that turns P_* = mu_* b / mu_maj into probabilities
+// proportional to |mu_*| that sum to 1, so the channel's technique still samples null events.
+template <int N>
+Spectrum<N> failing_share(const MediumSample<N>& m, const Spectrum<N>& mu_n,
+                          const Spectrum<N>& mu_maj) {
+  Spectrum<N> b(1.0);
+  for (int i = 0; i < N; ++i)
+    if (mu_n[i] < 0) b[i] = mu_maj[i] / (m.mu_a[i] + m.mu_s[i] - mu_n[i]);
+  return b;
+}
+
+// Spectral MIS's majorants per channel, each raised where mu_t exceeds it (raise_majorant): every
+// channel's technique raises at the same points, so the path pdfs stay those of the techniques.
+template <int N>
+void raise_majorants(Spectrum<N>& mu_maj, const Spectrum<N>& mu_t, TrackingCounters& counters) {
+  bool raised = false;
+  for (int c = 0; c < N; ++c)
+    if (mu_t[c] > mu_maj[c]) {
+      mu_maj[c] = kMajorantRaise * mu_t[c];
+      raised = true;
+    }
+  counters.raised += raised;
 }
 
 // The free flight that passes the segment's end, over distance d: every path pdf is rescaled by
@@ -65,26 +89,26 @@ Collision hero_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>
                         MisPath<N>& path, Spectrum<N>& emitted, Rng& rng,
                         TrackingCounters& counters) {
   Collision c{CollisionEvent::Escape, t1};
-  double t_prev = t0;  // the last tentative collision
+  double t_prev = t0;        // the last tentative collision
+  Spectrum<N> maj = mu_maj;  // raised where it fails (raise_majorants)
   const bool escaped = track_tentative_collisions(
-      lookup, t0, t1, mu_maj[h], rng, counters, [&](double t, const MediumSample<N>& m) {
+      lookup, t0, t1, maj[h], rng, counters, [&](double t, const MediumSample<N>& m) {
         const double dt = t - t_prev;
         t_prev = t;
-        const Spectrum<N> T_maj = exp(mu_maj * -dt);
+        const Spectrum<N> T_maj = exp(maj * -dt);
         const Spectrum<N> mu_a_Le = m.mu_a * m.L_e;
         if (!mu_a_Le.is_black()) {
-          const double pdf = T_maj[h] * mu_maj[h];
-          const Spectrum<N> r_e = path.r_u * mu_maj * T_maj / pdf;
+          const double pdf = T_maj[h] * maj[h];
+          const Spectrum<N> r_e = path.r_u * maj * T_maj / pdf;
           if (r_e.average() > 0) emitted += path.beta * T_maj / pdf * mu_a_Le / r_e.average();
         }
         const Spectrum<N> mu_t = m.mu_t();
-        const Spectrum<N> mu_n = mu_maj - mu_t;
-        if (mu_n.max() < 0) ++counters.clamped;
-        // b: where a channel's majorant fails, its technique's P_a and P_s are scaled to sum to 1.
-        Spectrum<N> bounded;
-        for (int i = 0; i < N; ++i) bounded[i] = mu_n[i] < 0 ? mu_maj[i] / mu_t[i] : 1.0;
-        const double P_a = m.mu_a[h] / mu_maj[h] * bounded[h];
-        const double P_s = m.mu_s[h] / mu_maj[h] * bounded[h];
+        const Spectrum<N> mu_n = maj - mu_t;
+        const Spectrum<N> drawn = maj;  // the collision's rates; raised for the next flights
+        raise_majorants(maj, mu_t, counters);
+        const Spectrum<N> b = failing_share(m, mu_n, drawn);
+        const double P_a = m.mu_a[h] / drawn[h] * b[h];
+        const double P_s = m.mu_s[h] / drawn[h] * b[h];
         const double u = rng.uniform();
         if (u < P_a) {
           path.beta = Spectrum<N>(0.0);
@@ -92,17 +116,18 @@ Collision hero_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>
           return false;
         }
         if (u < P_a + P_s) {
-          const double pdf = T_maj[h] * m.mu_s[h] * bounded[h];
+          const double pdf = T_maj[h] * m.mu_s[h] * b[h];
           path.beta *= T_maj * m.mu_s / pdf;
-          path.r_u *= T_maj * m.mu_s * bounded / pdf;
+          path.r_u *= T_maj * m.mu_s * b / pdf;
           c = {CollisionEvent::Scatter, t};
           return false;
         }
-        const double pdf = T_maj[h] * mu_n[h];
+        const Spectrum<N> mu_n_abs = abs_of(mu_n);
+        const double pdf = T_maj[h] * mu_n_abs[h] * b[h];
         if (pdf > 0) {
           path.beta *= T_maj * mu_n / pdf;
-          path.r_u *= T_maj * clamp_zero(mu_n) / pdf;
-          path.r_l *= T_maj * mu_maj / pdf;
+          path.r_u *= T_maj * mu_n_abs * b / pdf;
+          path.r_l *= T_maj * drawn / pdf;
         }
         if (!(pdf > 0) || path.beta.is_black() || path.r_u.is_black()) {
           path.beta = Spectrum<N>(0.0);
@@ -111,7 +136,7 @@ Collision hero_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>
         }
         return true;
       });
-  if (escaped) rescale_to_segment_end(path, mu_maj, h, t1 - t_prev);
+  if (escaped) rescale_to_segment_end(path, maj, h, t1 - t_prev);
   return c;
 }
 
@@ -124,17 +149,18 @@ Collision hero_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>
 template <int N, class Lookup>
 bool hero_ratio_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>& mu_maj, int h,
                          MisPath<N>& path, Rng& rng, TrackingCounters& counters) {
-  double t_prev = t0;  // the last tentative collision
+  double t_prev = t0;        // the last tentative collision
+  Spectrum<N> maj = mu_maj;  // raised where it fails (raise_majorants)
   const bool reached = track_tentative_collisions(
-      lookup, t0, t1, mu_maj[h], rng, counters, [&](double t, const MediumSample<N>& m) {
+      lookup, t0, t1, maj[h], rng, counters, [&](double t, const MediumSample<N>& m) {
         const double dt = t - t_prev;
         t_prev = t;
-        const Spectrum<N> T_maj = exp(mu_maj * -dt);
-        const Spectrum<N> mu_n = mu_maj - m.mu_t();
-        const double pdf = T_maj[h] * mu_maj[h];
+        const Spectrum<N> T_maj = exp(maj * -dt);
+        const Spectrum<N> mu_n = maj - m.mu_t();
+        const double pdf = T_maj[h] * maj[h];
         path.beta *= T_maj * mu_n / pdf;
-        path.r_l *= T_maj * mu_maj / pdf;
-        path.r_u *= T_maj * clamp_zero(mu_n) / pdf;
+        path.r_l *= T_maj * maj / pdf;
+        path.r_u *= T_maj * abs_of(mu_n) * failing_share(m, mu_n, maj) / pdf;
         const Spectrum<N> T = path.beta / (path.r_u + path.r_l).average();
         if (T.max_abs() < 0.05) {  // |T|: a majorant that fails makes it signed
           if (rng.uniform() < 0.75)
@@ -142,9 +168,10 @@ bool hero_ratio_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N
           else
             path.beta /= 0.25;
         }
+        raise_majorants(maj, m.mu_t(), counters);
         return !path.beta.is_black();
       });
-  if (reached) rescale_to_segment_end(path, mu_maj, h, t1 - t_prev);
+  if (reached) rescale_to_segment_end(path, maj, h, t1 - t_prev);
   return reached;
 }
 

@@ -5,7 +5,8 @@
 // and multiply per-channel ratios. Their expectation is exactly T = exp(−∫ mu_t) for any
 // mu_bar > 0 (the product over a Poisson process of (1 − f(t_i)/mu_bar) has expectation
 // exp(−∫ f)), so they stay unbiased when mu_bar does not bound mu_t: the weight then just goes
-// negative at some collisions. A bounding mu_bar keeps every factor in [0, 1].
+// negative at some collisions. A bounding mu_bar keeps every factor in [0, 1]; one that fails is
+// raised for the rest of the segment (raise_majorant).
 //
 // `lookup(t)` returns the MediumSample<N> at the point x(t) of the ray.
 
@@ -50,7 +51,9 @@ Spectrum<N> ratio_tracking(Lookup&& lookup, double t0, double t1, double mu_bar,
   Spectrum<N> T = T_in;
   track_tentative_collisions(lookup, t0, t1, mu_bar, rng, counters,
                              [&](double, const MediumSample<N>& m) {
+                               const double needed = largest_carried(m.mu_t(), T);
                                T *= Spectrum<N>(1.0) - m.mu_t() / mu_bar;
+                               raise_majorant(mu_bar, needed, counters);
                                return !T.is_black() && transmittance_roulette(T, rng);
                              });
   return T;
@@ -68,7 +71,11 @@ Spectrum<N> residual_ratio_tracking(Lookup&& lookup, double t0, double t1, const
   Spectrum<N> T = T_in * exp(mu_c * (t0 - t1));
   track_tentative_collisions(lookup, t0, t1, mu_bar_r, rng, counters,
                              [&](double, const MediumSample<N>& m) {
+                               Spectrum<N> gap = m.mu_t() - mu_c;
+                               for (int c = 0; c < N; ++c) gap[c] = std::abs(gap[c]);
+                               const double needed = largest_carried(gap, T);
                                T *= Spectrum<N>(1.0) - (m.mu_t() - mu_c) / mu_bar_r;
+                               raise_majorant(mu_bar_r, needed, counters);
                                return !T.is_black() && transmittance_roulette(T, rng);
                              });
   return T;
