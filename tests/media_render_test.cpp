@@ -371,8 +371,9 @@ void expect_chandrasekhar(double theta0_deg, double theta_deg, const Rgb& albedo
     Medium m;
     m.sigma_s = w;
     m.sigma_a = Rgb(1.0) - w;  // mu_t = 1
-    return render(test::half_space_scene(theta0_deg, theta_deg, m, Rgb(2.0),
-                                         {6, 6, 2048, 3, 100000, tracking, {}, RenderSettings::Sampler::Independent}));
+    return render(test::half_space_scene(
+        theta0_deg, theta_deg, m, Rgb(2.0),
+        {6, 6, 2048, 3, 100000, tracking, {}, RenderSettings::Sampler::Independent}));
   };
   Rgb ref;
   for (int c = 0; c < 3; ++c) ref[c] = test::half_space_reflected_radiance(2.0, albedo[c], mu0, mu);
@@ -487,9 +488,10 @@ TEST_P(MediaRender, SingleScatteringInAChromaticFieldMatchesQuadrature) {
 Scene light_in_medium(Surface::Type surface, double density, TrackingSettings::Mode mode) {
   Scene scene;
   scene.settings = {
-      8,  8,    1024,
-      31, 1000, test::tracking_settings(mode, TrackingSettings::Absorption::Collide, false, 4),
-      {}, RenderSettings::Sampler::Independent};
+      8,    8,
+      1024, 31,
+      1000, test::tracking_settings(mode, TrackingSettings::Absorption::Collide, false, 4),
+      {},   RenderSettings::Sampler::Independent};
   scene.camera = orthographic_camera({0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 2.1, 8, 8);
   Medium m;
   m.sigma_s = Rgb({1.0, 2.0, 3.0}) * density;

@@ -14,9 +14,12 @@
 namespace nimbus {
 namespace {
 
+// The tests here take their tolerances from per-pixel sample variances, which estimate the
+// variance of a pixel's mean for independent samples only: they ask for the independent sampler
+// (the default sampler meets these references in sampler_render_test.cpp).
 Scene sphere_scene(const Surface& surface, int size, int spp) {
   Scene scene;
-  scene.settings = {size, size, spp, 7, 1000, {}, {}};
+  scene.settings = {size, size, spp, 7, 1000, {}, {}, RenderSettings::Sampler::Independent};
   scene.camera = orthographic_camera({0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 2.5, size, size);
   SceneObject obj;
   obj.tape = compile(*make_shape(QuadricNode{sphere({0, 0, 0}, 1)}));
@@ -112,7 +115,7 @@ void expect_sphere_light_on_floor(TrackingSettings::Mode mode) {
   const double r = 0.6, L_s = 5.0, albedo = 0.7;
   const Vec3 c{0.3, 2.0, -0.2};
   Scene scene;
-  scene.settings = {size, size, 512, 9, 1000, {}, {}};
+  scene.settings = {size, size, 512, 9, 1000, {}, {}, RenderSettings::Sampler::Independent};
   scene.settings.tracking.mode = mode;
   // Looking down at the floor from the side, past the light; the view is 1 unit wide.
   scene.camera = orthographic_camera({3, 3, 3}, {0, 0, 0}, {0, 1, 0}, 1.0, size, size);

@@ -147,6 +147,10 @@ std::vector<BadScene> bad_scenes() {
        with_camera(R"("integrator": {"seed": -1})"),
        {},
        "scene.json: /integrator/seed: must be >= 0"},
+      {"unknown sampler",
+       with_camera(R"("integrator": {"sampler": "sobol"})"),
+       {},
+       R"(scene.json: /integrator/sampler: unknown sampler "sobol" (expected one of: zsobol, independent))"},
       {"unknown tracking",
        with_camera(R"("integrator": {"tracking": "ratio"})"),
        {},
@@ -452,6 +456,7 @@ TEST(SceneLoad, ExampleLoads) {
   EXPECT_EQ(s.camera.from, (Vec3{0, 1, 6}));
   EXPECT_EQ(s.camera.fov, 35);
   EXPECT_EQ(s.integrator.spp, 64);
+  EXPECT_EQ(s.integrator.sampler, RenderSettings::Sampler::ZSobol);
   EXPECT_EQ(s.integrator.tracking.mode, TrackingSettings::Mode::SpectralMis);
 
   ASSERT_EQ(s.lights.size(), 4u);
@@ -647,8 +652,9 @@ TEST(SceneLoad, OverridesReplaceAndCreateValues) {
            {"integrator.spp=256", "camera.from=[1, 2, 3]", "camera.type=orthographic",
             "integrator.majorant.scale=1.5", "film.width=100", "film.width=200",
             "lights.0.radiance=[0.1, 0.2, 0.3]", R"(integrator.tracking="spectral-mis")",
-            "integrator.octree={\"depth\": 3}"});
+            "integrator.octree={\"depth\": 3}", R"(integrator.sampler="independent")"});
   EXPECT_EQ(s.integrator.spp, 256);
+  EXPECT_EQ(s.integrator.sampler, RenderSettings::Sampler::Independent);
   EXPECT_EQ(s.camera.from, (Vec3{1, 2, 3}));
   EXPECT_EQ(s.camera.type, CameraDesc::Type::Orthographic);
   EXPECT_EQ(s.integrator.tracking.majorant_scale, 1.5);

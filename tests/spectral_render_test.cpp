@@ -80,9 +80,19 @@ constexpr double kWhiteFurnaceSE = 0.05, kEmissiveFurnaceSE = 0.02, kChandrasekh
 
 // A unit sphere holding `medium` (index-matched) under a white environment (D65 in spectral
 // mode), with the case's tracking and wavelength count.
+// The tests here take their tolerances from sample variances, which estimate the variance of a
+// mean for independent samples only: every scene asks for the independent sampler (the default
+// sampler meets these references in sampler_render_test.cpp).
 Scene furnace_scene(const SpectralCase& c, const Medium& medium, uint64_t seed, int spp = 64) {
   Scene scene;
-  scene.settings = {12, 12, spp, seed, 100000, tracking_of(c), spectral(c.wavelengths)};
+  scene.settings = {12,
+                    12,
+                    spp,
+                    seed,
+                    100000,
+                    tracking_of(c),
+                    spectral(c.wavelengths),
+                    RenderSettings::Sampler::Independent};
   scene.camera = perspective_camera({0, 0.3, 3.5}, {0, 0, 0}, {0, 1, 0}, 40, 12, 12);
   scene.media.push_back(medium);
   scene.objects.push_back(
@@ -191,7 +201,8 @@ Scene half_space(const SpectralCase& c, double albedo_scale) {
   SpectralParam sun(Rgb(2.0));
   sun.curve = constant_spectrum(2.0);
   return test::half_space_scene(0, 30, m, sun,
-                                {6, 6, 2048, 3, 100000, tracking_of(c), spectral(c.wavelengths)});
+                                {6, 6, 2048, 3, 100000, tracking_of(c), spectral(c.wavelengths),
+                                 RenderSettings::Sampler::Independent});
 }
 
 TEST_P(SpectralRender, ChandrasekharHalfSpace) {
@@ -229,9 +240,10 @@ INSTANTIATE_TEST_SUITE_P(Modes, SpectralRender, testing::ValuesIn(spectral_cases
 Scene ball_under_sky(double albedo_scale) {
   Scene scene;
   scene.settings = {
-      8,          8,    256,
-      13,         1000, test::tracking_settings(Mode::SpectralMis, Absorption::Collide, false, 0),
-      spectral(8)};
+      8,           8,
+      256,         13,
+      1000,        test::tracking_settings(Mode::SpectralMis, Absorption::Collide, false, 0),
+      spectral(8), RenderSettings::Sampler::Independent};
   scene.camera = orthographic_camera({0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.6, 8, 8);
   SceneObject ball =
       test::object_of(make_shape(QuadricNode{sphere({0, 0, 0}, 1)}), Surface::Type::Diffuse, -1);
@@ -267,7 +279,7 @@ Scene grey_scene(const SpectralSettings& spectrum, double light_scale = 1) {
   Scene scene;
   const TrackingSettings t =
       test::tracking_settings(Mode::SpectralMis, Absorption::Collide, false, 4);
-  scene.settings = {8, 8, 512, 11, 100000, t, {}};
+  scene.settings = {8, 8, 512, 11, 100000, t, {}, RenderSettings::Sampler::Independent};
   scene.settings.spectral = spectrum;
   scene.camera = perspective_camera({0, 1.2, 4}, {0, 0, 0}, {0, 1, 0}, 45, 8, 8);
   Medium cloud;

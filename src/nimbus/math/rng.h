@@ -33,15 +33,26 @@ class Rng {
     const uint32_t rot = static_cast<uint32_t>(old >> 59u);
     return (xorshifted >> rot) | (xorshifted << ((-rot) & 31));
   }
-  // Uniform in [0, 1), 53 random bits.
+  // Uniform in [0, 1), 53 random bits; or the number given to set_next, once.
   constexpr double uniform() {
+    if (next_ >= 0) {
+      const double u = next_;
+      next_ = -1;
+      return u;
+    }
     const uint64_t hi = next_u32(), lo = next_u32();
     return static_cast<double>(((hi << 32) | lo) >> 11) * 0x1.0p-53;
   }
+  // The next uniform() returns u in [0, 1) instead of the stream's number, which stays for the
+  // call after: a sampler's number for the first of the numbers an estimator draws a variable
+  // count of (render/path_sampler.h). clear_next drops it if unused.
+  constexpr void set_next(double u) { next_ = u; }
+  constexpr void clear_next() { next_ = -1; }
 
  private:
   uint64_t state_;
   uint64_t inc_;
+  double next_ = -1;  // < 0: none
 };
 
 }  // namespace nimbus

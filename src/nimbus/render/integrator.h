@@ -5,6 +5,7 @@
 // (render/render_channels.cpp.in).
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -13,6 +14,7 @@
 #include "nimbus/math/rng.h"
 #include "nimbus/media/medium_field.h"
 #include "nimbus/render/counters.h"
+#include "nimbus/render/path_sampler.h"
 #include "nimbus/render/path_spectra.h"
 #include "nimbus/render/sampling.h"
 #include "nimbus/render/scene.h"
@@ -37,8 +39,8 @@ inline int solid_containing(const Scene& scene, const Vec3& p) {
   return -1;
 }
 
-// One light sample for next-event estimation at p, with the scattering function's value there
-// and the shadow ray's origin; none if the light cannot contribute.
+// One light sample for next-event estimation at p, from the 2D number u, with the scattering
+// function's value there and the shadow ray's origin; none if the light cannot contribute.
 template <int N>
 struct LightCandidate {
   LightSample ls;
@@ -50,10 +52,10 @@ struct LightCandidate {
 template <int N, class F>
 std::optional<LightCandidate<N>> light_candidate(const Scene& scene, const PathSpectra<N>& ps,
                                                  int light_index, const Vec3& p, const Vec3& n,
-                                                 bool on_surface, F&& f, Rng& rng) {
+                                                 bool on_surface, F&& f,
+                                                 const std::array<double, 2>& u) {
   const Light& light = scene.lights[light_index];
-  const double u1 = rng.uniform(), u2 = rng.uniform();
-  const auto ls = sample_light(light, p, u1, u2);
+  const auto ls = sample_light(light, p, u[0], u[1]);
   if (!ls) return std::nullopt;
   if (on_surface && dot(ls->wi, n) <= 0) return std::nullopt;
   const Spectrum<N> fv = f(ls->wi);
@@ -64,20 +66,26 @@ std::optional<LightCandidate<N>> light_candidate(const Scene& scene, const PathS
 
 // Light reaching p along one sample of every light (next-event estimation), times the
 // scattering function `f(wi)` (cosine included for surfaces) and the policy's weight for the
-// shadow ray (its transmittance, and MIS with the sampling of f).
+// shadow ray (its transmittance, and MIS with the sampling of f). Light i's numbers come from
+// its dimensions in the block of `bounce` (SampleDims::light).
 template <int N, class Policy, class F, class Pdf>
 Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Vec3& p, const Vec3& n,
                          bool on_surface, int inside, const Policy& policy, F&& f, Pdf&& f_pdf,
-                         Rng& rng, Counters& counters) {
+                         PathSampler& sampler, uint32_t bounce, Counters& counters) {
   Spectrum<N> L(0.0);
   for (int i = 0; i < static_cast<int>(scene.lights.size()); ++i) {
-    const auto cand = light_candidate(scene, ps, i, p, n, on_surface, f, rng);
+    const uint32_t dims = SampleDims::light(bounce, i);
+    const auto cand = light_candidate(scene, ps, i, p, n, on_surface, f,
+                                      sampler.get2d(dims + SampleDims::kLightPoint));
     if (!cand) continue;
     const LightSample& ls = cand->ls;
     Spectrum<N> term;
-    if (policy.light_term(scene, ps, {cand->origin, ls.wi}, ls.distance * kShadowShrink, i, inside,
-                          ls, cand->f * cand->Li, f_pdf, rng, counters, term))
-      L += term;
+    sampler.first_from(dims + SampleDims::kShadow);
+    const bool lit =
+        policy.light_term(scene, ps, {cand->origin, ls.wi}, ls.distance * kShadowShrink, i, inside,
+                          ls, cand->f * cand->Li, f_pdf, sampler.rng(), counters, term);
+    sampler.done();
+    if (lit) L += term;
   }
   return L;
 }
@@ -91,19 +99,25 @@ struct PhaseSample {
   double pdf;
 };
 
+// The lobe from dimension `bounce` + kChoice, the direction from `bounce` + kDirection.
 template <int N>
-PhaseSample<N> draw_phase(const MediumPoint<N>& m, const Vec3& dir, Rng& rng) {
-  const double u0 = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+PhaseSample<N> draw_phase(const MediumPoint<N>& m, const Vec3& dir, PathSampler& sampler,
+                          uint32_t bounce) {
+  const double u0 = sampler.get1d(bounce + SampleDims::kChoice);
+  const std::array<double, 2> u = sampler.get2d(bounce + SampleDims::kDirection);
   PhaseSample<N> ps;
-  ps.wi = sample_phase(m, dir, u0, u1, u2, ps.weight, ps.pdf);
+  ps.wi = sample_phase(m, dir, u0, u[0], u[1], ps.weight, ps.pdf);
   return ps;
 }
 
 // The one path loop: radiance along a camera ray, with the tracking mode's policy
-// (tracking_policies.h) for what differs between modes.
+// (tracking_policies.h) for what differs between modes. Each bounce takes its numbers from its
+// block of the sampler's dimensions (SampleDims), the tracking estimators from the path's stream.
 template <int N, class Policy>
-Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Rng& rng,
+Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, PathSampler& sampler,
                        Counters& counters, Policy& policy) {
+  Rng& rng = sampler.rng();
+  const int lights = static_cast<int>(scene.lights.size());
   Spectrum<N> L(0.0);
   int inside = solid_containing(scene, ray.o);  // the solid (dielectric) the path is in, or -1
   // The last vertex sampled the lights (next-event estimation), so a light the path hits next
@@ -112,10 +126,15 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Rn
   Vec3 prev_p = ray.o;  // where the current direction was sampled
 
   for (int depth = 0;; ++depth) {
+    const uint32_t bounce = SampleDims::bounce(depth, lights);
+    // Roulette's number is drawn only when roulette plays (the independent sampler's order).
+    const auto roulette_u = [&] { return sampler.get1d(bounce + SampleDims::kRoulette); };
     ++counters.surface_rays;
     const auto hit = intersect(scene, ray, kInf);
     const double t_surface = hit ? hit->t : kInf;
+    sampler.first_from(bounce + SampleDims::kFreeFlight);
     const MediumEvent<N> ev = policy.collide(scene, ps, ray, t_surface, inside, rng, counters);
+    sampler.done();
     L += ev.emitted;
     if (ev.type == MediumEvent<N>::Type::Absorb) break;
     if (ev.type == MediumEvent<N>::Type::Scatter) {
@@ -129,13 +148,14 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Rn
              direct_light(
                  scene, ps, p, {}, false, inside, policy,
                  [&](const Vec3& wi) { return phase_value(m, dot(ray.d, wi)); },
-                 [&](const Vec3& wi) { return phase_pdf(m, dot(ray.d, wi)); }, rng, counters);
-      const PhaseSample<N> phase = draw_phase(m, ray.d, rng);
+                 [&](const Vec3& wi) { return phase_pdf(m, dot(ray.d, wi)); }, sampler, bounce,
+                 counters);
+      const PhaseSample<N> phase = draw_phase(m, ray.d, sampler, bounce);
       policy.scattered(phase.weight, phase.pdf);
       prev_p = p;
       light_sampled = inside < 0;
       ray = {p, phase.wi};
-      if (!policy.roulette(depth, rng)) break;
+      if (!policy.roulette(depth, roulette_u)) break;
       continue;
     }
 
@@ -166,21 +186,22 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Rn
       L += policy.throughput() * direct_light(
                                      scene, ps, p, ns, true, inside, policy,
                                      [&](const Vec3& wi) { return f * dot(wi, ns); },
-                                     [&](const Vec3& wi) { return dot(wi, ns) * kInvPi; }, rng,
-                                     counters);
-      const double u1 = rng.uniform(), u2 = rng.uniform();
-      const Vec3 wi = sample_cosine_hemisphere(ns, u1, u2);
+                                     [&](const Vec3& wi) { return dot(wi, ns) * kInvPi; }, sampler,
+                                     bounce, counters);
+      const std::array<double, 2> u = sampler.get2d(bounce + SampleDims::kDirection);
+      const Vec3 wi = sample_cosine_hemisphere(ns, u[0], u[1]);
       policy.scattered(albedo, dot(wi, ns) * kInvPi);  // f cos / pdf = albedo
       prev_p = p;
       light_sampled = true;
       ray = {offset_origin(scene, p, ns, wi), wi};
     } else {
-      const DielectricSample ds = sample_dielectric(-ray.d, n, obj.surface.ior, rng.uniform());
+      const DielectricSample ds = sample_dielectric(-ray.d, n, obj.surface.ior,
+                                                    sampler.get1d(bounce + SampleDims::kChoice));
       if (!ds.reflected) inside = dot(ds.wi, n) < 0 ? hit->object : -1;
       light_sampled = false;
       ray = {offset_origin(scene, p, n, ds.wi), ds.wi};
     }
-    if (!policy.roulette(depth, rng)) break;
+    if (!policy.roulette(depth, roulette_u)) break;
   }
   return L;
 }
@@ -188,16 +209,16 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Rn
 }  // namespace integrator_detail
 
 template <int N>
-Spectrum<N> radiance(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Rng& rng,
+Spectrum<N> radiance(const Scene& scene, const PathSpectra<N>& ps, Ray ray, PathSampler& sampler,
                      Counters& counters) {
   using namespace integrator_detail;
   ++counters.paths;
   if (scene.settings.tracking.mode == TrackingSettings::Mode::SpectralMis) {
-    HeroTracking<N> policy(rng);
-    return trace_path(scene, ps, ray, rng, counters, policy);
+    HeroTracking<N> policy(sampler.get1d(SampleDims::kHero));
+    return trace_path(scene, ps, ray, sampler, counters, policy);
   }
-  PlainTracking<N> policy(rng);
-  return trace_path(scene, ps, ray, rng, counters, policy);
+  PlainTracking<N> policy;
+  return trace_path(scene, ps, ray, sampler, counters, policy);
 }
 
 }  // namespace nimbus

@@ -12,7 +12,9 @@
 #include <chrono>
 #include <mutex>
 
+#include "nimbus/math/zsobol.h"
 #include "nimbus/render/integrator.h"
+#include "nimbus/render/path_sampler.h"
 #include "nimbus/render/path_spectra.h"
 #include "nimbus/render/renderer.h"
 
@@ -34,6 +36,7 @@ RenderStats render_channels(const Scene& scene, Film& film, const RenderRange& r
   std::atomic<bool> cancelled{false};
   std::mutex progress_mutex;
   const auto start = std::chrono::steady_clock::now();
+  const ZSobol zsobol(W, scene.settings.height, scene.settings.spp, scene.settings.seed);
 
   constexpr int kTile = 16;
   tbb::parallel_for(
@@ -50,11 +53,11 @@ RenderStats render_channels(const Scene& scene, Film& film, const RenderRange& r
             }
             const int pixel = y * W + x;
             for (int s = range.s0; s < range.s1; ++s) {
-              Rng rng = Rng::for_sample(scene.settings.seed, uint64_t(pixel), uint64_t(s));
-              const double u1 = rng.uniform(), u2 = rng.uniform();
-              const Ray ray = scene.camera.generate(x + u1, y + u2);
-              if (spectral) prepare_path_spectra(ps, scene, rng.uniform());
-              const Spectrum<N> L = radiance(scene, ps, ray, rng, local);
+              PathSampler sampler(scene.settings, zsobol, x, y, uint64_t(pixel), uint64_t(s));
+              const std::array<double, 2> u = sampler.get2d(SampleDims::kCamera);
+              const Ray ray = scene.camera.generate(x + u[0], y + u[1]);
+              if (spectral) prepare_path_spectra(ps, scene, sampler.get1d(SampleDims::kWavelength));
+              const Spectrum<N> L = radiance(scene, ps, ray, sampler, local);
               if (!film.add(pixel, to_film_rgb(L, ps.ch))) ++local.rejected_samples;
             }
           }

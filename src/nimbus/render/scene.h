@@ -43,12 +43,17 @@ struct SpectralSettings {
 };
 
 struct RenderSettings {
+  // Where a pixel sample's numbers come from (render/path_sampler.h): Owen-scrambled Sobol' in
+  // Morton order (math/zsobol.h), or independent PCG numbers, whose per-pixel sample variance
+  // estimates the variance of the pixel's mean (tests that rely on it ask for it).
+  enum class Sampler { ZSobol, Independent };
   int width = 640, height = 480;
   int spp = 16;
   uint64_t seed = 0;
   int max_depth = 1000;
   TrackingSettings tracking;
   SpectralSettings spectral;
+  Sampler sampler = Sampler::ZSobol;
 };
 
 struct SceneObject {

@@ -33,6 +33,10 @@ inline constexpr std::array<std::pair<std::string_view, SpectralSettings::Mode>,
     kSpectrumModeNames = {
         {{"rgb", SpectralSettings::Mode::Rgb}, {"spectral", SpectralSettings::Mode::Spectral}}};
 
+inline constexpr std::array<std::pair<std::string_view, RenderSettings::Sampler>, 2>
+    kSamplerNames = {{{"zsobol", RenderSettings::Sampler::ZSobol},
+                      {"independent", RenderSettings::Sampler::Independent}}};
+
 // The name of a value in its table.
 template <class E, size_t K>
 constexpr std::string_view name_of(const std::array<std::pair<std::string_view, E>, K>& table,

@@ -27,12 +27,13 @@
 
 namespace nimbus {
 
-// Continues the path with probability q = min(1, max|beta / scale|) from depth 3 on.
-template <int N>
-bool russian_roulette(Spectrum<N>& beta, double scale, int depth, Rng& rng) {
+// Continues the path with probability q = min(1, max|beta / scale|) from depth 3 on; u() gives
+// the uniform number, called only when roulette plays.
+template <int N, class U>
+bool russian_roulette(Spectrum<N>& beta, double scale, int depth, U&& u) {
   if (depth < 3) return true;
   const double q = std::min(1.0, beta.max_abs() / scale);
-  if (q <= 0 || rng.uniform() >= q) return false;
+  if (q <= 0 || u() >= q) return false;
   beta /= q;  // unbiased: survivors carry 1/q
   return true;
 }
@@ -40,8 +41,6 @@ bool russian_roulette(Spectrum<N>& beta, double scale, int depth, Rng& rng) {
 template <int N>
 class PlainTracking {
  public:
-  explicit PlainTracking(Rng&) {}
-
   // The path throughput, which multiplies next-event estimates.
   const Spectrum<N>& throughput() const { return beta_; }
 
@@ -81,7 +80,10 @@ class PlainTracking {
     prev_pdf_ = pdf;
   }
 
-  bool roulette(int depth, Rng& rng) { return russian_roulette(beta_, 1.0, depth, rng); }
+  template <class U>
+  bool roulette(int depth, U&& u) {
+    return russian_roulette(beta_, 1.0, depth, u);
+  }
 
  private:
   Spectrum<N> beta_{1.0};
@@ -95,7 +97,8 @@ class PlainTracking {
 template <int N>
 class HeroTracking {
  public:
-  explicit HeroTracking(Rng& rng) : hero_(std::min(N - 1, static_cast<int>(rng.uniform() * N))) {}
+  // u: the uniform number that picks the hero channel.
+  explicit HeroTracking(double u) : hero_(std::min(N - 1, static_cast<int>(u * N))) {}
 
   const Spectrum<N>& throughput() const { return path_.beta; }
 
@@ -143,8 +146,9 @@ class HeroTracking {
     path_.r_l = path_.r_u / pdf;
   }
 
-  bool roulette(int depth, Rng& rng) {
-    return russian_roulette(path_.beta, path_.r_u.average(), depth, rng);
+  template <class U>
+  bool roulette(int depth, U&& u) {
+    return russian_roulette(path_.beta, path_.r_u.average(), depth, u);
   }
 
  private:

@@ -220,6 +220,7 @@ class Loader {
     if (auto x = o.optional("spp")) d.spp = x->integer(at_least(1));
     if (auto x = o.optional("seed")) d.seed = x->unsigned_integer();
     if (auto x = o.optional("max_depth")) d.max_depth = x->integer(at_least(1));
+    if (auto x = o.optional("sampler")) d.sampler = choice_of(*x, "sampler", kSamplerNames);
     TrackingSettings& t = d.tracking;
     if (auto x = o.optional("tracking")) t.mode = choice_of(*x, "tracking", kTrackingModeNames);
     if (auto x = o.optional("absorption"))

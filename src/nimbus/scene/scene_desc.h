@@ -32,6 +32,7 @@ struct IntegratorDesc {
   int spp = 16;
   uint64_t seed = 0;
   int max_depth = 1000;
+  RenderSettings::Sampler sampler = RenderSettings::Sampler::ZSobol;
   TrackingSettings tracking;  // its defaults are the scene format's
 };
 
