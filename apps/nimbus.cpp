@@ -25,12 +25,15 @@
 #include "nimbus/io/film_image.h"
 #include "nimbus/io/output.h"
 #include "nimbus/io/vdb_export.h"
+#include "nimbus/job/checkpoint.h"
+#include "nimbus/job/fingerprint.h"
 #include "nimbus/render/memory_estimate.h"
 #include "nimbus/render/path_spectra.h"
 #include "nimbus/render/renderer.h"
 #include "nimbus/render/stats.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
+#include "render_job.h"
 
 namespace {
 
@@ -47,11 +50,15 @@ struct RenderArgs {
   std::string stats;
   std::string max_memory;  // empty: the system's available memory
   bool quiet = false;
+  std::string checkpoint;
+  double checkpoint_interval = 0;  // 0: not given (60 s)
+  std::string resume;
 };
 
 // SIGINT, SIGTERM and SIGHUP: the first one during a render stops it before its next pixel
-// (nothing is written, exit 128 + the signal's number); during writing, or a second one, removes
-// every temporary file and ends the process by the signal at once.
+// (exit 128 + the signal's number; nothing is written, or with checkpoints the checkpoint and
+// the image so far); during writing, or a second one, removes every temporary file and ends the
+// process by the signal at once.
 std::atomic<int> g_signal{0};
 std::atomic<bool> g_writing{false};
 
@@ -93,9 +100,15 @@ std::function<void(double)> progress_bar(const char* what) {
   };
 }
 
+// A step's outcome: exit code 0 (go on), or the code and the one line to print.
+struct Outcome {
+  int code = 0;
+  std::string message;
+};
+
 // Refuses, with one line and exit 2, a render that the machine (or --max-memory) cannot hold,
-// before anything large is allocated (render/memory_estimate.h); 0 if it fits.
-int check_memory(const nimbus::SceneDesc& desc, const RenderArgs& args) {
+// before anything large is allocated (render/memory_estimate.h).
+Outcome check_memory(const nimbus::SceneDesc& desc, const RenderArgs& args) {
   using namespace nimbus;
   int octrees = 1;
   for (const ObjectDesc& o : desc.objects)
@@ -114,98 +127,153 @@ int check_memory(const nimbus::SceneDesc& desc, const RenderArgs& args) {
       limit = available_memory();
     }
   } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "nimbus: --max-memory: %s\n", e.what());
-    return kExitBadInput;
+    return {kExitBadInput, fmt::format("nimbus: --max-memory: {}", e.what())};
   }
-  if (limit > 0 && need.total() > double(limit)) {
-    std::fprintf(stderr,
-                 "nimbus: the render needs about %s (film %s, image %s, majorant octrees %s), "
-                 "more than the %s %s\n",
-                 format_memory(need.total()).c_str(), format_memory(need.film).c_str(),
-                 format_memory(need.image).c_str(), format_memory(need.octrees).c_str(),
-                 format_memory(double(limit)).c_str(), source.c_str());
-    return kExitBadInput;
-  }
-  return 0;
+  if (limit > 0 && need.total() > double(limit))
+    return {kExitBadInput,
+            fmt::format("nimbus: the render needs about {} (film {}, image {}, majorant octrees "
+                        "{}), more than the {} {}",
+                        format_memory(need.total()), format_memory(need.film),
+                        format_memory(need.image), format_memory(need.octrees),
+                        format_memory(double(limit)), source)};
+  return {};
 }
 
-int run_render(const RenderArgs& args) {
+// Under mpirun every rank runs each step and all agree on its outcome (cluster_agree): a
+// failure is printed once, by rank 0, and every rank exits with its code. Returns that code.
+int agree(const Cluster& cluster, const Outcome& mine) {
+  const ClusterFailure f = cluster_agree(mine.code, mine.message);
+  if (f.code != 0 && cluster.rank == 0)
+    std::fprintf(stderr, "%s\n",
+                 f.rank == 0 ? f.message.c_str()
+                             : fmt::format("nimbus: rank {}: {}", f.rank, f.message).c_str());
+  return f.code;
+}
+
+// The render's inputs once every rank has agreed that they are good.
+struct Prepared {
+  std::vector<std::string> outputs;
+  std::vector<std::string> overrides;
+  std::string checkpoint;      // where checkpoints go; empty: none
+  nimbus::Checkpoint resumed;  // --resume's checkpoint (rank 0)
+  nimbus::SceneDesc desc;
+};
+
+// Rank 0 alone checks the outputs and reads the checkpoint to resume (the other ranks write
+// and read nothing); every rank loads the scene.
+Outcome prepare(const RenderArgs& args, const Cluster& cluster, Prepared& p) {
   using namespace nimbus;
-  std::vector<std::string> overrides = args.sets;
-  if (args.spp > 0) overrides.push_back(fmt::format("integrator.spp={}", args.spp));
-  if (args.seed >= 0) overrides.push_back(fmt::format("integrator.seed={}", args.seed));
+  const bool lead = cluster.rank == 0;
+  p.overrides = args.sets;
+  p.checkpoint = !args.checkpoint.empty() ? args.checkpoint : args.resume;
+  if (args.checkpoint_interval > 0 && p.checkpoint.empty())
+    return {kExitBadInput, "nimbus: --checkpoint-interval needs --checkpoint or --resume"};
+  int spp = args.spp;
+  if (lead && !args.resume.empty()) {
+    try {
+      p.resumed = load_checkpoint(args.resume);
+    } catch (const std::exception& e) {
+      return {kExitBadInput, fmt::format("nimbus: --resume: {}", e.what())};
+    }
+    // Without --spp a resumed render finishes what the checkpoint's render was asked for.
+    if (spp == 0) spp = p.resumed.spp;
+  }
+  if (spp > 0) p.overrides.push_back(fmt::format("integrator.spp={}", spp));
+  if (args.seed >= 0) p.overrides.push_back(fmt::format("integrator.seed={}", args.seed));
 
-  std::vector<std::string> outputs = args.outputs;
-  if (outputs.empty()) {
+  p.outputs = args.outputs;
+  if (p.outputs.empty()) {
     const std::string stem = std::filesystem::path(args.scene).stem().string();
-    outputs = {stem + ".exr", stem + ".png"};
+    p.outputs = {stem + ".exr", stem + ".png"};
   }
+  if (lead) try {
+      for (const std::string& out : p.outputs) check_output_path(out);
+      if (!args.stats.empty()) check_writable_path(args.stats);
+      if (!p.checkpoint.empty()) check_writable_path(p.checkpoint);
+    } catch (const std::exception& e) {
+      return {kExitBadInput, fmt::format("nimbus: {}", e.what())};
+    }
   try {
-    for (const std::string& out : outputs) check_output_path(out);
-    if (!args.stats.empty()) check_writable_path(args.stats);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "nimbus: %s\n", e.what());
-    return kExitBadInput;
-  }
-
-  SceneDesc desc;
-  try {
-    desc = load_scene_file(args.scene, overrides);
+    p.desc = load_scene_file(args.scene, p.overrides);
   } catch (const SceneError& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return kExitBadInput;
+    return {kExitBadInput, e.what()};
   }
+  if (lead && !args.resume.empty()) {
+    const std::string diff =
+        fingerprint_difference(p.resumed.fingerprint, render_fingerprint(args.scene, p.overrides));
+    if (!diff.empty())
+      return {kExitBadInput,
+              fmt::format("nimbus: --resume {}: the checkpoint is of another scene or other "
+                          "settings ({})",
+                          args.resume, diff)};
+    if (p.resumed.film.width != p.desc.film.width || p.resumed.film.height != p.desc.film.height)
+      return {kExitBadInput, fmt::format("nimbus: --resume {}: a film of {}x{} pixels, the "
+                                         "scene's image is {}x{}",
+                                         args.resume, p.resumed.film.width, p.resumed.film.height,
+                                         p.desc.film.width, p.desc.film.height)};
+    const uint32_t most =
+        *std::max_element(p.resumed.film.samples.begin(), p.resumed.film.samples.end());
+    if (most > uint32_t(p.desc.integrator.spp))
+      return {kExitBadInput, fmt::format("nimbus: --resume {}: pixels of the checkpoint hold {} "
+                                         "samples, more than --spp {}",
+                                         args.resume, most, p.desc.integrator.spp)};
+  }
+  return check_memory(p.desc, args);
+}
 
-  if (const int refused = check_memory(desc, args); refused != 0) return refused;
-
-  const bool show_progress = !args.quiet && isatty(fileno(stderr));
+// Every rank compiles the scene and builds its own majorant octrees; they must be the same bits
+// on every rank (and, on resume, those of the checkpoint's render).
+Outcome compile(const Prepared& p, bool show_progress, nimbus::Scene& scene) {
+  using namespace nimbus;
   // The majorant octrees can take seconds to build (deep trees, sampled bounds): they get a
   // bar of their own, and a signal stops them too.
   BuildMonitor monitor;
   monitor.cancel = [] { return g_signal.load() != 0; };
   if (show_progress) monitor.progress = progress_bar("octrees");
-  Scene scene;
   try {
-    scene = compile_scene(desc, monitor);
+    scene = compile_scene(p.desc, monitor);
   } catch (const SceneError& e) {
     if (show_progress) std::fprintf(stderr, "\n");
-    std::fprintf(stderr, "%s\n", e.what());
-    return kExitBadInput;
+    return {kExitBadInput, e.what()};
   }
   if (show_progress) std::fprintf(stderr, "\n");
-  if (const int sig = g_signal.load(); sig != 0) {
-    std::fprintf(stderr,
-                 "nimbus: stopped by %s while building the majorant octrees; nothing written\n",
-                 signal_name(sig));
-    return 128 + sig;
-  }
+  if (const int sig = g_signal.load(); sig != 0)
+    return {128 + sig,
+            fmt::format("nimbus: stopped by {} while building the majorant octrees; nothing "
+                        "written",
+                        signal_name(sig))};
+  return {};
+}
 
-  RenderOptions options;
-  options.threads = args.threads;
-  options.cancel = [] { return g_signal.load() != 0; };
-  if (show_progress) options.progress = progress_bar("render");
-  const RenderResult result = render(scene, options);
-  if (show_progress) std::fprintf(stderr, "\n");
-  if (const int sig = g_signal.load(); sig != 0) {
-    std::fprintf(stderr, "nimbus: stopped by %s before the render finished; nothing written\n",
-                 signal_name(sig));
-    return 128 + sig;
-  }
-  if (const uint64_t n = result.counters.rejected_samples; n > 0)
-    std::fprintf(stderr,
-                 "nimbus: warning: %llu samples were NaN or infinite and counted as 0 "
-                 "(counters.rejected_samples in --stats)\n",
-                 static_cast<unsigned long long>(n));
+// The checks of the octrees after compile: equal on every rank (a collective call).
+Outcome check_majorants(const Cluster& cluster, const Prepared& p, const RenderArgs& args,
+                        uint64_t mine) {
+  const uint64_t lead = cluster_broadcast(mine);
+  if (mine != lead)
+    return {1, fmt::format("built majorant octrees that differ from rank 0's (hash {:016x}, "
+                           "rank 0 {:016x}): are all ranks running the same nimbus?",
+                           mine, lead)};
+  if (cluster.rank == 0 && !args.resume.empty() && p.resumed.majorants != mine)
+    return {kExitBadInput, fmt::format("nimbus: --resume {}: the checkpoint's majorant octrees "
+                                       "differ from this render's (another nimbus build?)",
+                                       args.resume)};
+  return {};
+}
 
-  // All or nothing: every output is written to its temporary file first, and only when all are
-  // complete are they renamed into place (io/atomic_file.h).
+// Writes every output as one transaction (io/atomic_file.h): all of them, or none.
+int write_outputs(const RenderArgs& args, const std::vector<std::string>& outputs,
+                  const nimbus::Scene& scene, const nimbus::RenderResult& result,
+                  const nlohmann::json& extra_stats) {
+  using namespace nimbus;
   g_writing = true;
   try {
     OutputTransaction outputs_of_this_run;
     const Image image = to_image(result.film);
     for (const std::string& out : outputs) write_image(out, image);
     if (!args.stats.empty()) {
-      const std::string text = render_stats(scene, result, args.scene).dump(2) + "\n";
+      nlohmann::json stats = render_stats(scene, result, args.scene);
+      stats.update(extra_stats);
+      const std::string text = stats.dump(2) + "\n";
       write_atomically(args.stats, [&](const std::string& tmp) {
         std::ofstream f(tmp);
         f << text;
@@ -219,16 +287,145 @@ int run_render(const RenderArgs& args) {
     return kExitFailure;
   }
   g_writing = false;
+  return 0;
+}
+
+void warn_rejected(const nimbus::Counters& counters) {
+  if (const uint64_t n = counters.rejected_samples; n > 0)
+    std::fprintf(stderr,
+                 "nimbus: warning: %llu samples were NaN or infinite and counted as 0 "
+                 "(counters.rejected_samples in --stats)\n",
+                 static_cast<unsigned long long>(n));
+}
+
+std::string joined(const std::vector<std::string>& list) {
+  std::string s;
+  for (const auto& o : list) s += (s.empty() ? "" : ", ") + o;
+  return s;
+}
+
+// The render in one call, in this process: no checkpoints, no other ranks.
+int render_at_once(const RenderArgs& args, const Prepared& p, const nimbus::Scene& scene,
+                   bool show_progress) {
+  using namespace nimbus;
+  RenderOptions options;
+  options.threads = args.threads;
+  options.cancel = [] { return g_signal.load() != 0; };
+  if (show_progress) options.progress = progress_bar("render");
+  const RenderResult result = render(scene, options);
+  if (show_progress) std::fprintf(stderr, "\n");
+  if (const int sig = g_signal.load(); sig != 0) {
+    std::fprintf(stderr, "nimbus: stopped by %s before the render finished; nothing written\n",
+                 signal_name(sig));
+    return 128 + sig;
+  }
+  warn_rejected(result.counters);
+  if (const int failed = write_outputs(args, p.outputs, scene, result, {}); failed != 0)
+    return failed;
   if (!args.quiet) {
     const double samples =
         double(scene.settings.width) * scene.settings.height * scene.settings.spp;
-    std::string list;
-    for (const auto& o : outputs) list += (list.empty() ? "" : ", ") + o;
     std::fprintf(stderr, "nimbus: %dx%d, %d spp in %.2f s (%.3g samples/s, %d threads) -> %s\n",
                  scene.settings.width, scene.settings.height, scene.settings.spp, result.seconds,
-                 samples / result.seconds, result.threads, list.c_str());
+                 samples / result.seconds, result.threads, joined(p.outputs).c_str());
   }
   return 0;
+}
+
+// Rank 0 of a render job (apps/render_job.h): under mpirun, or with --checkpoint or --resume.
+int lead_render_job(const RenderArgs& args, const Cluster& cluster, const Prepared& p,
+                    const nimbus::Scene& scene, bool show_progress) {
+  using namespace nimbus;
+  JobSettings job;
+  job.spp = scene.settings.spp;
+  job.threads = args.threads;
+  job.start =
+      args.resume.empty() ? Film(scene.settings.width, scene.settings.height) : p.resumed.film;
+  const uint64_t held_at_start = samples_held(job.start);
+  if (!p.checkpoint.empty()) {
+    Checkpoint header;
+    header.fingerprint = render_fingerprint(args.scene, p.overrides);
+    header.majorants = majorant_hash(scene);
+    header.spp = scene.settings.spp;
+    job.checkpoint_interval = args.checkpoint_interval > 0 ? args.checkpoint_interval : 60;
+    // Units are short next to the interval, so checkpoints come on time.
+    job.unit_seconds = std::min(job.unit_seconds, job.checkpoint_interval / 4);
+    job.checkpoint = [header, path = p.checkpoint](const Film& film) mutable {
+      header.film = film;
+      try {
+        save_checkpoint(header, path);
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "\nnimbus: warning: --checkpoint: %s; the render goes on\n", e.what());
+      }
+    };
+  }
+  if (show_progress) job.progress = progress_bar("render");
+  job.stop = [] { return g_signal.load() != 0; };
+  const JobResult r = lead_job(scene, cluster, std::move(job));
+  if (show_progress) std::fprintf(stderr, "\n");
+  const int sig = g_signal.load();
+  // Stopped without a checkpoint: as a render in one call, nothing is written. With one, the
+  // film holds whole units only, and its image so far is written too.
+  if (r.stopped && p.checkpoint.empty()) {
+    std::fprintf(stderr, "nimbus: stopped by %s before the render finished; nothing written\n",
+                 signal_name(sig));
+    return 128 + sig;
+  }
+  warn_rejected(r.counters);
+  RenderResult result;
+  result.film = std::move(r.film);
+  result.counters = r.counters;
+  result.seconds = r.seconds;
+  result.threads = args.threads > 0 ? args.threads : int(std::thread::hardware_concurrency());
+  nlohmann::json extra;
+  if (cluster.mpi)
+    extra["mpi"] = {{"ranks", cluster.size}, {"samples_per_rank", r.samples_per_rank}};
+  const uint64_t held = samples_held(result.film);
+  if (!p.checkpoint.empty())
+    extra["checkpoint"] = {
+        {"file", p.checkpoint}, {"samples_at_start", held_at_start}, {"samples", held}};
+  if (const int failed = write_outputs(args, p.outputs, scene, result, extra); failed != 0)
+    return failed;
+  const double total = double(scene.settings.width) * scene.settings.height * scene.settings.spp;
+  if (r.stopped) {
+    std::fprintf(stderr,
+                 "nimbus: stopped by %s at %.1f%% of the samples; wrote the image so far to %s "
+                 "and the checkpoint %s (continue with --resume %s)\n",
+                 signal_name(sig), 100 * double(held) / total, joined(p.outputs).c_str(),
+                 p.checkpoint.c_str(), p.checkpoint.c_str());
+    return 128 + sig;
+  }
+  if (!args.quiet) {
+    const double samples = double(held - held_at_start);
+    std::fprintf(stderr,
+                 "nimbus: %dx%d, %d spp in %.2f s (%.3g samples/s, %d threads x %d %s) -> %s\n",
+                 scene.settings.width, scene.settings.height, scene.settings.spp, r.seconds,
+                 samples / r.seconds, result.threads, cluster.size,
+                 cluster.size == 1 ? "process" : "ranks", joined(p.outputs).c_str());
+  }
+  return 0;
+}
+
+int run_render(const RenderArgs& args, const Cluster& cluster) {
+  using namespace nimbus;
+  const bool lead = cluster.rank == 0;
+  Prepared p;
+  if (const int code = agree(cluster, prepare(args, cluster, p)); code != 0) return code;
+  const bool show_progress = lead && !args.quiet && isatty(fileno(stderr));
+  Scene scene;
+  if (const int code = agree(cluster, compile(p, show_progress, scene)); code != 0) return code;
+  if (const int code = agree(cluster, check_majorants(cluster, p, args, majorant_hash(scene)));
+      code != 0)
+    return code;
+
+  if (!cluster.mpi && p.checkpoint.empty()) return render_at_once(args, p, scene, show_progress);
+  if (!lead) {
+    work_on_job(scene, args.threads, [] { return g_signal.load() != 0; });
+    return receive_exit_code();
+  }
+  const int code = lead_render_job(args, cluster, p, scene, show_progress);
+  send_exit_code(cluster, code);
+  return code;
 }
 
 // nimbus's data (scenes/, tools/plot_*.py): share/nimbus beside the executable (the build tree
@@ -423,7 +620,7 @@ CLI::Validator integer_in(long long lo, long long hi = std::numeric_limits<int>:
       fmt::format("INT >= {}", lo));
 }
 
-int main(int argc, char** argv) {
+int run_command(int argc, char** argv, const Cluster& cluster) {
   CLI::App app{"nimbus: renders functionally specified objects and participating media"};
   app.set_version_flag("--version", std::string("nimbus ") + NIMBUS_VERSION);
   app.require_subcommand(1);
@@ -448,6 +645,17 @@ int main(int argc, char** argv) {
                      "Refuse renders estimated to need more memory than this (e.g. 8G, 512M; "
                      "default: the system's available memory)");
   render->add_flag("-q,--quiet", args.quiet, "Print nothing but errors");
+  render->add_option("--checkpoint", args.checkpoint,
+                     "Save the render's state to this file now and then, when it ends and when "
+                     "a signal stops it (docs/cli.md)");
+  render
+      ->add_option("--checkpoint-interval", args.checkpoint_interval,
+                   "Seconds between checkpoints (default 60)")
+      ->check(CLI::PositiveNumber);
+  render->add_option("--resume", args.resume,
+                     "Continue the render of this checkpoint up to --spp (default: the spp it "
+                     "was started with); later checkpoints go to the same file unless "
+                     "--checkpoint says otherwise");
 
   ExperimentArgs exp;
   std::string names;
@@ -484,16 +692,32 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    // Under mpirun every rank parses the same command line: rank 0 alone says what is wrong.
+    if (cluster.rank != 0) return e.get_exit_code() == 0 ? 0 : kExitBadInput;
     const int code = app.exit(e);
     return code == 0 ? 0 : kExitBadInput;
   }
   try {
+    if (cluster.size > 1 && !render->parsed()) {
+      if (cluster.rank == 0)
+        std::fprintf(stderr, "nimbus: only render runs on several MPI ranks (docs/cli.md)\n");
+      return kExitBadInput;
+    }
     if (experiment->parsed()) return run_experiment(exp);
     catch_stop_signals();
     if (export_vdb->parsed()) return run_export_vdb(exp_vdb);
-    return run_render(args);
+    return run_render(args, cluster);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "nimbus: %s\n", e.what());
+    // The other ranks may be waiting for this one: end them all.
+    if (cluster.size > 1) cluster_abort(kExitFailure);
     return kExitFailure;
   }
+}
+
+int main(int argc, char** argv) {
+  const Cluster cluster = cluster_start(&argc, &argv);
+  const int code = run_command(argc, argv, cluster);
+  cluster_end();
+  return code;
 }

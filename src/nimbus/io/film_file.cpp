@@ -19,19 +19,51 @@ static_assert(std::endian::native == std::endian::little, "film files are little
 
 }  // namespace
 
+void write_film(std::ostream& out, const Film& film) {
+  auto put = [&](const auto& v) { out.write(reinterpret_cast<const char*>(&v), sizeof v); };
+  out.write(kFilmMagic, sizeof kFilmMagic);
+  put(kFilmVersion);
+  put(static_cast<int32_t>(film.width));
+  put(static_cast<int32_t>(film.height));
+  for (int p = 0; p < film.pixels(); ++p) {
+    put(film.samples[p]);
+    for (int c = 0; c < 3; ++c) put(film.sum[p].c[c]);
+    for (int c = 0; c < 3; ++c) put(film.sum_sq[p][c]);
+  }
+}
+
+Film read_film(std::istream& in, const std::string& name) {
+  auto get = [&](auto& v) {
+    in.read(reinterpret_cast<char*>(&v), sizeof v);
+    if (!in) throw std::runtime_error(name + ": the film file is cut short");
+  };
+  char magic[sizeof kFilmMagic];
+  in.read(magic, sizeof magic);
+  if (!in || std::memcmp(magic, kFilmMagic, sizeof magic) != 0)
+    throw std::runtime_error(name + ": not a nimbus film file");
+  uint32_t version = 0;
+  get(version);
+  if (version != kFilmVersion)
+    throw std::runtime_error(
+        fmt::format("{}: film file version {}, this nimbus reads {}", name, version, kFilmVersion));
+  int32_t w = 0, h = 0;
+  get(w);
+  get(h);
+  if (w <= 0 || h <= 0 || w > 1 << 16 || h > 1 << 16)
+    throw std::runtime_error(fmt::format("{}: a film of {}x{} pixels", name, w, h));
+  Film film(w, h);
+  for (int p = 0; p < film.pixels(); ++p) {
+    get(film.samples[p]);
+    for (int c = 0; c < 3; ++c) get(film.sum[p].c[c]);
+    for (int c = 0; c < 3; ++c) get(film.sum_sq[p][c]);
+  }
+  return film;
+}
+
 void save_film(const Film& film, const std::string& path) {
   write_atomically(path, [&](const std::string& temp) {
     std::ofstream out(temp, std::ios::binary);
-    auto put = [&](const auto& v) { out.write(reinterpret_cast<const char*>(&v), sizeof v); };
-    out.write(kFilmMagic, sizeof kFilmMagic);
-    put(kFilmVersion);
-    put(static_cast<int32_t>(film.width));
-    put(static_cast<int32_t>(film.height));
-    for (int p = 0; p < film.pixels(); ++p) {
-      put(film.samples[p]);
-      for (int c = 0; c < 3; ++c) put(film.sum[p].c[c]);
-      for (int c = 0; c < 3; ++c) put(film.sum_sq[p][c]);
-    }
+    write_film(out, film);
     out.flush();
     if (!out) throw std::runtime_error("cannot write the film");
   });
@@ -40,30 +72,7 @@ void save_film(const Film& film, const std::string& path) {
 Film load_film(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open the film file");
-  auto get = [&](auto& v) {
-    in.read(reinterpret_cast<char*>(&v), sizeof v);
-    if (!in) throw std::runtime_error(path + ": the film file is cut short");
-  };
-  char magic[sizeof kFilmMagic];
-  in.read(magic, sizeof magic);
-  if (!in || std::memcmp(magic, kFilmMagic, sizeof magic) != 0)
-    throw std::runtime_error(path + ": not a nimbus film file");
-  uint32_t version = 0;
-  get(version);
-  if (version != kFilmVersion)
-    throw std::runtime_error(
-        fmt::format("{}: film file version {}, this nimbus reads {}", path, version, kFilmVersion));
-  int32_t w = 0, h = 0;
-  get(w);
-  get(h);
-  if (w <= 0 || h <= 0 || w > 1 << 16 || h > 1 << 16)
-    throw std::runtime_error(fmt::format("{}: a film of {}x{} pixels", path, w, h));
-  Film film(w, h);
-  for (int p = 0; p < film.pixels(); ++p) {
-    get(film.samples[p]);
-    for (int c = 0; c < 3; ++c) get(film.sum[p].c[c]);
-    for (int c = 0; c < 3; ++c) get(film.sum_sq[p][c]);
-  }
+  Film film = read_film(in, path);
   if (in.peek() != std::char_traits<char>::eof())
     throw std::runtime_error(path + ": trailing bytes after the film");
   return film;

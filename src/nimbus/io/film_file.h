@@ -2,6 +2,7 @@
 // A film (render/film.h) in a file, to resume or extend a render and to merge renders made
 // elsewhere.
 
+#include <iosfwd>
 #include <string>
 
 #include "nimbus/render/film.h"
@@ -16,5 +17,10 @@ void save_film(const Film& film, const std::string& path);
 // Loads a film saved by save_film; std::runtime_error("PATH: problem") if the file is missing,
 // not a film, of another version, cut short or followed by other bytes.
 Film load_film(const std::string& path);
+
+// The same bytes on a stream, for files that hold a film among other things (job/checkpoint.h).
+// read_film stops after the film; `name` prefixes its errors.
+void write_film(std::ostream& out, const Film& film);
+Film read_film(std::istream& in, const std::string& name);
 
 }  // namespace nimbus

@@ -1,0 +1,224 @@
+#include "render_job.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <stdexcept>
+#include <thread>
+#include <type_traits>
+
+#include "nimbus/job/film_patch.h"
+#include "nimbus/job/work_queue.h"
+#include "nimbus/render/renderer.h"
+
+namespace {
+
+using namespace nimbus;
+using Clock = std::chrono::steady_clock;
+
+// Message tags: a worker's report (its last unit's result, if any, and a request for the next;
+// or that it leaves the job), rank 0's reply (a unit, or the end of the job), and the exit code
+// at the very end.
+constexpr int kReportTag = 1, kReplyTag = 2, kExitTag = 3;
+
+// A worker stopped by a signal gives back the unit it was rendering and leaves the job
+// (Abandoned); rank 0 finishes the job with the others, so a signal to one rank alone stops
+// only that rank.
+enum class Report : uint8_t { Request, Result, Abandoned };
+enum class Reply : uint8_t { Unit, Done };
+
+static_assert(std::is_trivially_copyable_v<WorkUnit> && std::is_trivially_copyable_v<Counters>);
+
+// A message's bytes. Appended by resize and memcpy: GCC 12 warns, wrongly, about
+// vector::insert of byte ranges (-Warray-bounds).
+struct Writer {
+  std::vector<std::byte> bytes;
+  void append(const void* data, size_t size) {
+    const size_t at = bytes.size();
+    bytes.resize(at + size);
+    if (size > 0) std::memcpy(bytes.data() + at, data, size);
+  }
+  template <class T>
+  void put(const T& v) {
+    append(&v, sizeof v);
+  }
+};
+
+struct Reader {
+  std::span<const std::byte> bytes;
+  template <class T>
+  T get() {
+    if (bytes.size() < sizeof(T)) throw std::runtime_error("a message cut short");
+    T v;
+    std::memcpy(&v, bytes.data(), sizeof v);
+    bytes = bytes.subspan(sizeof v);
+    return v;
+  }
+};
+
+// A unit's render into `scratch` (which holds no samples in the unit's pixels), cancelled
+// when `stop` says so; the result is moved out of the scratch film.
+struct UnitResult {
+  FilmPatch patch;
+  RenderStats stats;
+};
+UnitResult render_unit(const Scene& scene, Film& scratch, const WorkUnit& u, int threads,
+                       const std::function<bool()>& stop) {
+  RenderOptions options;
+  options.threads = threads;
+  options.range = {u.rect.x0, u.rect.y0, u.rect.x1, u.rect.y1, u.s0, u.s1};
+  options.cancel = stop;
+  UnitResult r;
+  r.stats = render_into(scene, scratch, options);
+  r.patch = take_patch(scratch, u.rect);
+  return r;
+}
+
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+// Rank 0's main thread until the job is over: answers the other ranks' reports, draws the
+// progress, saves checkpoints.
+void serve(WorkQueue& queue, const Cluster& cluster, const JobSettings& s,
+           const std::function<bool()>& stop) {
+  std::vector<int> waiting;  // ranks that asked for a unit and have not had an answer
+  int gone = 0;              // ranks that were told the job is over, or left it
+  auto last_checkpoint = Clock::now();
+  auto last_progress = Clock::time_point{};
+  for (;;) {
+    if (stop() && !queue.stopped()) queue.stop();
+    while (std::optional<ClusterMessage> m = cluster_poll(kReportTag)) {
+      Reader in{m->bytes};
+      const auto kind = in.get<Report>();
+      if (kind == Report::Result || kind == Report::Abandoned) {
+        const auto unit = in.get<WorkUnit>();
+        const auto seconds = in.get<double>();
+        const auto counters = in.get<Counters>();
+        if (kind == Report::Result)
+          queue.complete(m->from, unit, unpack_patch(in.bytes), seconds, counters);
+        else
+          queue.abandon(unit);
+      }
+      if (kind == Report::Request || kind == Report::Result)
+        waiting.push_back(m->from);
+      else
+        ++gone;
+    }
+    const bool over = queue.stopped() || queue.finished();
+    for (auto it = waiting.begin(); it != waiting.end();) {
+      Writer out;
+      if (const std::optional<WorkUnit> u = queue.try_next()) {
+        out.put(Reply::Unit);
+        out.put(*u);
+      } else if (over) {
+        out.put(Reply::Done);
+        ++gone;
+      } else {
+        ++it;
+        continue;
+      }
+      cluster_send(*it, kReplyTag, out.bytes);
+      it = waiting.erase(it);
+    }
+    if (s.progress && seconds_since(last_progress) > 0.1) {
+      s.progress(queue.fraction_done());
+      last_progress = Clock::now();
+    }
+    if (s.checkpoint && !over && seconds_since(last_checkpoint) >= s.checkpoint_interval) {
+      queue.with_film(s.checkpoint);
+      last_checkpoint = Clock::now();
+    }
+    if (over && queue.none_out() && gone == cluster.size - 1) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+}
+
+}  // namespace
+
+JobResult lead_job(const Scene& scene, const Cluster& cluster, JobSettings s) {
+  const auto start = Clock::now();
+  const int H = scene.settings.height;
+  // Four bands per rank at least, so every rank has lanes to take; at most 16 rows (the
+  // renderer's tile), so the bands of a dense region are short.
+  const int band_height = std::clamp(H / (4 * cluster.size), 1, 16);
+  WorkQueue queue(std::move(s.start), s.spp, band_height, cluster.size, s.unit_seconds);
+  const auto stop = [&] { return s.stop && s.stop(); };
+
+  std::exception_ptr local_failure;
+  std::thread local([&] {
+    try {
+      Film scratch(scene.settings.width, H);
+      while (const std::optional<WorkUnit> u = queue.wait_next()) {
+        const UnitResult r = render_unit(scene, scratch, *u, s.threads, stop);
+        if (r.stats.cancelled)
+          queue.abandon(*u);
+        else
+          queue.complete(0, *u, r.patch, r.stats.seconds, r.stats.counters);
+      }
+    } catch (...) {
+      local_failure = std::current_exception();
+      queue.stop();
+    }
+  });
+
+  try {
+    serve(queue, cluster, s, stop);
+  } catch (...) {
+    queue.stop();
+    local.join();
+    throw;
+  }
+  local.join();
+  if (local_failure) std::rethrow_exception(local_failure);
+
+  JobResult result;
+  result.stopped = !queue.finished();
+  if (s.progress && !result.stopped) s.progress(1.0);
+  if (s.checkpoint) queue.with_film(s.checkpoint);
+  result.film = queue.film();
+  result.counters = queue.counters();
+  result.samples_per_rank = queue.samples_per_rank();
+  result.seconds = seconds_since(start);
+  return result;
+}
+
+void work_on_job(const Scene& scene, int threads, const std::function<bool()>& stop) {
+  Film scratch(scene.settings.width, scene.settings.height);
+  Writer report;
+  report.put(Report::Request);
+  for (;;) {
+    cluster_send(0, kReportTag, report.bytes);
+    const ClusterMessage m = cluster_receive(0, kReplyTag);
+    Reader in{m.bytes};
+    if (in.get<Reply>() == Reply::Done) return;
+    const auto unit = in.get<WorkUnit>();
+    const UnitResult r = render_unit(scene, scratch, unit, threads, stop);
+    report = {};
+    if (r.stats.cancelled) {
+      report.put(Report::Abandoned);
+      report.put(unit);
+      report.put(r.stats.seconds);
+      report.put(r.stats.counters);
+      cluster_send(0, kReportTag, report.bytes);
+      return;
+    }
+    report.put(Report::Result);
+    report.put(unit);
+    report.put(r.stats.seconds);
+    report.put(r.stats.counters);
+    const std::vector<std::byte> patch = pack_patch(r.patch);
+    report.append(patch.data(), patch.size());
+  }
+}
+
+void send_exit_code(const Cluster& cluster, int code) {
+  Writer out;
+  out.put(int32_t(code));
+  for (int r = 1; r < cluster.size; ++r) cluster_send(r, kExitTag, out.bytes);
+}
+
+int receive_exit_code() {
+  const ClusterMessage m = cluster_receive(0, kExitTag);
+  return Reader{m.bytes}.get<int32_t>();
+}

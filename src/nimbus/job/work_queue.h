@@ -1,0 +1,90 @@
+#pragma once
+// The work of a render job, handed out unit by unit to whoever asks: the threads of this process
+// or other processes (MPI ranks). A unit is a band of pixel rows and a range of sample indices;
+// the job's film holds only finished units, so at any moment it is a valid state to checkpoint,
+// and every pixel then holds its samples [0, n) for some n.
+//
+// The image is cut into lanes: bands of rows whose pixels hold the same number of samples (a
+// film from a checkpoint of another band layout is cut into row runs of equal count). A lane
+// has at most one unit out at a time, so its units are merged in sample order; the next unit
+// goes to the lane with the fewest samples, so lanes advance together and the last units are
+// short. A lane's first unit is one sample; later ones are sized from its measured cost to take
+// about `unit_seconds`, so a costly lane (a dense cloud) gets short units and the others long
+// ones. Pixels are the same bits however units fall to threads or processes: sums are exact
+// (render/exact_sum.h).
+
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <vector>
+
+#include "nimbus/job/film_patch.h"
+#include "nimbus/render/counters.h"
+#include "nimbus/render/film.h"
+
+namespace nimbus {
+
+struct WorkUnit {
+  PixelRect rect;
+  int s0 = 0, s1 = 0;  // sample indices [s0, s1)
+  int lane = 0;
+};
+
+// The lanes of a film whose pixels are to reach more samples: bands of `band_height` rows,
+// split into row runs where a band's pixels hold different counts.
+std::vector<PixelRect> lanes_of(const Film& film, int band_height);
+
+class WorkQueue {
+ public:
+  // Continues `start` (a fresh film, or a checkpoint's) until every pixel holds `spp` samples;
+  // std::invalid_argument if a pixel already holds more. `ranks`: the processes taking units,
+  // for samples_per_rank.
+  WorkQueue(Film start, int spp, int band_height, int ranks, double unit_seconds);
+
+  // The next unit, or none when every lane is done or has a unit out, or after stop().
+  std::optional<WorkUnit> try_next();
+  // Waits for the next unit; none once the job is finished or stopped.
+  std::optional<WorkUnit> wait_next();
+  // Merges a unit's result (rendered by `rank` in `seconds`).
+  void complete(int rank, const WorkUnit& unit, const FilmPatch& result, double seconds,
+                const Counters& counters);
+  // Gives a unit back unrendered (its render was cancelled).
+  void abandon(const WorkUnit& unit);
+  void stop();
+
+  bool finished() const;  // every pixel holds spp samples
+  bool stopped() const;
+  bool none_out() const;         // no unit handed out and not yet completed or abandoned
+  double fraction_done() const;  // of the samples this job adds
+  // Calls f with the job's film, the units out blocked meanwhile (to save a checkpoint).
+  void with_film(const std::function<void(const Film&)>& f) const;
+  Film film() const;
+  Counters counters() const;
+  std::vector<uint64_t> samples_per_rank() const;  // pixel samples each rank rendered
+
+ private:
+  struct Lane {
+    PixelRect rect;
+    int done = 0;  // samples every pixel of the lane holds
+    bool out = false;
+    int last_chunk = 0;
+    double seconds_per_sample = 0;  // of the whole lane, measured; 0: not yet
+  };
+  std::optional<WorkUnit> next_locked();
+
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  Film film_;
+  int spp_;
+  double unit_seconds_;
+  std::vector<Lane> lanes_;
+  int out_ = 0;
+  bool stopped_ = false;
+  double total_ = 0, done_ = 0;  // pixel samples to add, added
+  Counters counters_;
+  std::vector<uint64_t> per_rank_;
+};
+
+}  // namespace nimbus

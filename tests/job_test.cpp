@@ -1,0 +1,146 @@
+// The pieces of a render job (src/nimbus/job/): film patches, the work queue's lanes and order,
+// checkpoint files and the fingerprint that a resumed render must match.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "nimbus/job/checkpoint.h"
+#include "nimbus/job/film_patch.h"
+#include "nimbus/job/fingerprint.h"
+#include "nimbus/job/work_queue.h"
+
+namespace nimbus {
+namespace {
+
+Film numbered_film(int w, int h) {
+  Film f(w, h);
+  for (int p = 0; p < f.pixels(); ++p) {
+    f.add(p, Rgb({0.25 * p, 1.0 / (p + 1), -3.0 * p}));
+    f.add(p, Rgb({1e-7 * p, 2.0, 0.5}));
+  }
+  return f;
+}
+
+TEST(FilmPatch, TakenPackedUnpackedAndMergedGivesTheFilmBack) {
+  Film film = numbered_film(7, 5);
+  const Film original = film;
+  const PixelRect rect{2, 1, 6, 4};
+  const FilmPatch taken = take_patch(film, rect);
+  EXPECT_EQ(film.samples[1 * 7 + 2], 0u);
+  EXPECT_EQ(film.samples[0], 2u);
+  const FilmPatch back = unpack_patch(pack_patch(taken));
+  merge_patch(film, back);
+  EXPECT_EQ(film.samples, original.samples);
+  EXPECT_EQ(film.sum, original.sum);
+  for (int p = 0; p < film.pixels(); ++p)
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(film.sum_sq[p][c], original.sum_sq[p][c]);
+  std::vector<std::byte> cut = pack_patch(taken);
+  cut.pop_back();
+  EXPECT_THROW(unpack_patch(cut), std::runtime_error);
+}
+
+TEST(WorkQueue, LanesAreBandsSplitWhereCountsDiffer) {
+  Film film(10, 6);
+  EXPECT_EQ(lanes_of(film, 4).size(), 2u);
+  film.samples[5 * 10 + 3] = 8;  // band 2, row 5: runs [0, 3), [3, 4), [4, 10); row 4: one run
+  const std::vector<PixelRect> lanes = lanes_of(film, 4);
+  ASSERT_EQ(lanes.size(), 5u);
+  EXPECT_EQ(lanes[0].y1, 4);
+  EXPECT_EQ(lanes[1].y0, 4);
+  EXPECT_EQ(lanes[1].x1, 10);
+  EXPECT_EQ(lanes[3].x0, 3);
+  EXPECT_EQ(lanes[3].x1, 4);
+}
+
+// Units come lane by lane in sample order, the least advanced lane first, and the film then
+// holds every sample once: here each "render" adds one sample of value s to each pixel.
+TEST(WorkQueue, HandsOutEverySampleOnceInOrderPerLane) {
+  const int spp = 7;
+  WorkQueue queue(Film(9, 10), spp, 3, 2, 0.001);
+  std::vector<int> next_sample(4, 0);
+  int units = 0, rank = 0;
+  while (const auto u = queue.try_next()) {
+    EXPECT_EQ(u->s0, next_sample.at(u->lane));
+    next_sample[u->lane] = u->s1;
+    Film scratch(9, 10);
+    for (int y = u->rect.y0; y < u->rect.y1; ++y)
+      for (int x = u->rect.x0; x < u->rect.x1; ++x)
+        for (int s = u->s0; s < u->s1; ++s) scratch.add(y * 9 + x, Rgb(double(s)));
+    queue.complete(rank, *u, take_patch(scratch, u->rect), 1e-4 * (u->s1 - u->s0), {});
+    rank = 1 - rank;
+    ++units;
+  }
+  EXPECT_TRUE(queue.finished());
+  EXPECT_DOUBLE_EQ(queue.fraction_done(), 1.0);
+  const Film film = queue.film();
+  for (int p = 0; p < film.pixels(); ++p) {
+    EXPECT_EQ(film.samples[p], uint32_t(spp));
+    EXPECT_EQ(film.mean(p)[0], 3.0);  // (0 + ... + 6) / 7
+  }
+  const std::vector<uint64_t> per_rank = queue.samples_per_rank();
+  EXPECT_EQ(per_rank[0] + per_rank[1], uint64_t(9 * 10 * spp));
+  EXPECT_GT(units, 4);  // lanes' first units are one sample
+  EXPECT_THROW(WorkQueue(film, spp - 1, 3, 1, 1), std::invalid_argument);
+}
+
+TEST(WorkQueue, AbandonedUnitsComeBackAndStopEndsTheHandingOut) {
+  WorkQueue queue(Film(4, 4), 2, 4, 1, 1);
+  const auto u = queue.try_next();
+  ASSERT_TRUE(u);
+  EXPECT_FALSE(queue.try_next());  // one lane, already out
+  queue.abandon(*u);
+  const auto again = queue.try_next();
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->s0, 0);
+  queue.abandon(*again);
+  queue.stop();
+  EXPECT_FALSE(queue.try_next());
+  EXPECT_FALSE(queue.wait_next());
+  EXPECT_FALSE(queue.finished());
+}
+
+TEST(Checkpoint, SavedAndLoadedBitForBit) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("nimbus_ckpt_" + std::to_string(::getpid())))
+          .string();
+  Checkpoint c;
+  c.fingerprint = {{"scene", {{"film", {{"width", 7}}}}}};
+  c.majorants = 0x123456789abcdefull;
+  c.spp = 24;
+  c.film = numbered_film(7, 5);
+  save_checkpoint(c, path);
+  const Checkpoint back = load_checkpoint(path);
+  EXPECT_EQ(back.fingerprint, c.fingerprint);
+  EXPECT_EQ(back.majorants, c.majorants);
+  EXPECT_EQ(back.spp, 24);
+  EXPECT_EQ(back.film.sum, c.film.sum);
+  EXPECT_EQ(back.film.samples, c.film.samples);
+  EXPECT_EQ(samples_held(back.film), uint64_t(2 * 35));
+  std::filesystem::resize_file(path, std::filesystem::file_size(path) - 1);
+  EXPECT_THROW(load_checkpoint(path), std::runtime_error);
+  std::ofstream(path) << "{\"film\": 1}";
+  try {
+    load_checkpoint(path);
+    ADD_FAILURE() << "a JSON file passed for a checkpoint";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": not a nimbus checkpoint");
+  }
+  std::filesystem::remove(path);
+}
+
+TEST(Fingerprint, NamesTheFirstSettingThatDiffers) {
+  const nlohmann::json a = {{"scene", {{"integrator", {{"seed", 1}}}, {"film", {{"width", 8}}}}}};
+  nlohmann::json b = a;
+  EXPECT_EQ(fingerprint_difference(a, b), "");
+  b["scene"]["integrator"]["seed"] = 2;
+  EXPECT_EQ(fingerprint_difference(a, b), "scene.integrator.seed: 1 in the checkpoint, 2 now");
+  b = a;
+  b["scene"]["integrator"]["tracking"] = "delta";
+  EXPECT_EQ(fingerprint_difference(a, b),
+            "scene.integrator.tracking: absent in the checkpoint, \"delta\" now");
+}
+
+}  // namespace
+}  // namespace nimbus
