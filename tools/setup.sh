@@ -9,6 +9,8 @@ packages=(
   # vdb_print, which the tests run on exported files
   libopenvdb-dev libnanovdb-dev libboost-iostreams-dev libopenvdb-tools
   colord-data python3-numpy python3-matplotlib
+  # MPI: `mpirun -np K nimbus render` (README, "Rendering on a cluster")
+  libopenmpi-dev openmpi-bin
 )
 missing=()
 for p in "${packages[@]}"; do
