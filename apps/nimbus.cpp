@@ -169,15 +169,20 @@ Outcome prepare(const RenderArgs& args, const Cluster& cluster, Prepared& p) {
   if (args.checkpoint_interval > 0 && p.checkpoint.empty())
     return {kExitBadInput, "nimbus: --checkpoint-interval needs --checkpoint or --resume"};
   int spp = args.spp;
+  Outcome resume_failed;
   if (lead && !args.resume.empty()) {
     try {
       p.resumed = load_checkpoint(args.resume);
+      // Without --spp a resumed render finishes what the checkpoint's render was asked for.
+      if (spp == 0) spp = p.resumed.spp;
     } catch (const std::exception& e) {
-      return {kExitBadInput, fmt::format("nimbus: --resume: {}", e.what())};
+      resume_failed = {kExitBadInput, fmt::format("nimbus: --resume: {}", e.what())};
     }
-    // Without --spp a resumed render finishes what the checkpoint's render was asked for.
-    if (spp == 0) spp = p.resumed.spp;
   }
+  // Every rank renders with rank 0's spp: a pixel's samples depend on it (integrator.sampler
+  // "zsobol"), and only rank 0 reads the checkpoint.
+  if (!args.resume.empty()) spp = int(cluster_broadcast(uint64_t(spp)));
+  if (resume_failed.code != 0) return resume_failed;
   if (spp > 0) p.overrides.push_back(fmt::format("integrator.spp={}", spp));
   if (args.seed >= 0) p.overrides.push_back(fmt::format("integrator.seed={}", args.seed));
 

@@ -63,4 +63,9 @@ inline std::string file_bytes(const std::filesystem::path& path) {
   return std::string(std::istreambuf_iterator<char>(f), {});
 }
 
+// Whether two files hold the same bytes (a test prints names, not megabytes, when they differ).
+inline bool same_bytes(const std::filesystem::path& a, const std::filesystem::path& b) {
+  return file_bytes(a) == file_bytes(b);
+}
+
 }  // namespace nimbus::testing
