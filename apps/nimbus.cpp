@@ -277,7 +277,7 @@ int write_outputs(const RenderArgs& args, const std::vector<std::string>& output
     for (const std::string& out : outputs) write_image(out, image);
     if (!args.stats.empty()) {
       nlohmann::json stats = render_stats(scene, result, args.scene);
-      stats.update(extra_stats);
+      if (extra_stats.is_object()) stats.update(extra_stats);
       const std::string text = stats.dump(2) + "\n";
       write_atomically(args.stats, [&](const std::string& tmp) {
         std::ofstream f(tmp);
