@@ -226,6 +226,7 @@ TEST_F(Cli, RendersDefaultOutputsAndStats) {
   EXPECT_GE(s["octree"]["depth"].get<int>(), 0);
   EXPECT_EQ(s["spectrum"]["mode"], "rgb");
   EXPECT_EQ(s["spectrum"]["channels"], 3);
+  EXPECT_EQ(s["sampler"], "zsobol");
   EXPECT_EQ(s["tracking"]["mode"], "spectral-mis");
   EXPECT_EQ(s["tracking"]["absorption"], "weight");
   EXPECT_EQ(s["counters"]["rejected_samples"], 0);

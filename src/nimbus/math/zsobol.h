@@ -88,11 +88,25 @@ constexpr uint64_t sobol1_reversed(uint64_t i) {
 }
 
 // A nested uniform (Owen) scramble of a reversed fraction, hash-based (Laine & Karras 2011):
-// adding a seed and multiplying (by odd numbers, or xoring a product with an even one) change
-// digit r as a function of the digits before it only, so elementary intervals map to elementary
-// intervals and nets stay nets; the seed's digit r enters digit r alone, so with a random seed
-// every scrambled point is uniform.
+// adding the seed, multiplying by odd numbers and xoring a product with an even one change digit
+// r as a function of the digits before it only, so elementary intervals map to elementary
+// intervals and nets stay nets. The seed enters by the addition alone: digit r of the result is
+// v's digit r xor the seed's digit r xor a function of lower digits, so with a random seed every
+// scrambled point is uniform.
 constexpr uint64_t owen_scramble_reversed(uint64_t v, uint64_t seed) {
+  v += seed;
+  v ^= v * 0x9e3779b97f4a7c16ull;
+  v *= 0xbf58476d1ce4e5b9ull;
+  v ^= v * 0x94d049bb133111eaull;
+  v *= 0xd6e8feb86659fd93ull;
+  v ^= v * 0x6a09e667f3bcc908ull;
+  return v;
+}
+
+// The same with multipliers drawn from the seed too: a richer family of nested permutations, at
+// three more hashes. The index shuffle takes it, as the pairing of one dimension's samples with
+// another's rests on it alone (the additive family pairs neighbouring dimensions visibly).
+constexpr uint64_t owen_scramble_reversed_rich(uint64_t v, uint64_t seed) {
   const uint64_t a = splitmix64(seed), b = splitmix64(a), c = splitmix64(b);
   v += a;
   v ^= v * (b << 1);
@@ -120,14 +134,19 @@ constexpr uint64_t shuffle_index(uint64_t index, int pixel_bits, int sample_bits
   for (int p = pixel_bits - 2; p >= 0; p -= 2) {
     // The digits above, with a leading 1 so that prefixes of different lengths differ.
     const uint64_t node = (pixel >> (p + 2)) | (uint64_t(1) << (pixel_bits - p - 2));
-    const uint64_t h = splitmix64(node ^ seed);
-    out |= uint64_t(zsobol_detail::kDigitPermutations[h % 24][(pixel >> p) & 3]) << p;
+    // One multiply-xorshift round mixes the node into the high half; their top bits pick the
+    // permutation (by multiply-shift range reduction).
+    uint64_t h = (node ^ seed) * 0xd6e8feb86659fd93ull;
+    h ^= h >> 29;
+    h *= 0x9e3779b97f4a7c15ull;
+    const uint64_t pick = ((h >> 32) * 24) >> 32;
+    out |= uint64_t(zsobol_detail::kDigitPermutations[pick][(pixel >> p) & 3]) << p;
   }
   if (sample_bits == 0) return out;
   // s's bits in the order of a reversed fraction (its top bit first), scrambled, and back.
   const uint64_t s = index & ((uint64_t(1) << sample_bits) - 1);
   const uint64_t r = zsobol_detail::reverse_bits(s << (64 - sample_bits));
-  const uint64_t scrambled = owen_scramble_reversed(r, splitmix64(seed ^ pixel));
+  const uint64_t scrambled = owen_scramble_reversed_rich(r, seed ^ pixel);
   return (out << sample_bits) | (zsobol_detail::reverse_bits(scrambled) >> (64 - sample_bits));
 }
 

@@ -35,9 +35,17 @@ struct SampleDims {
   static constexpr uint32_t kShadow = 2;      // 1D: the first number of its shadow ray's tracking
   static constexpr uint32_t kPerLight = 3;
 
+  // Bounces from kBounces on draw from the path's stream: a sampler's number costs about ten
+  // of the stream's, and stratification gains little that deep, while dense media make paths of
+  // hundreds of bounces. Their dimensions are kStream and above.
+  static constexpr int kBounces = 8;
+  static constexpr uint32_t kStream = 0x80000000u;
+
   // The first dimension of bounce `depth` (0 at the camera ray's end) with `lights` lights.
   static constexpr uint32_t bounce(int depth, int lights) {
-    return kFirstBounce + uint32_t(depth) * (kLights + kPerLight * uint32_t(lights));
+    return depth < kBounces
+               ? kFirstBounce + uint32_t(depth) * (kLights + kPerLight * uint32_t(lights))
+               : kStream;
   }
   static constexpr uint32_t light(uint32_t bounce, int i) {
     return bounce + kLights + kPerLight * uint32_t(i);
@@ -53,9 +61,11 @@ class PathSampler {
         key_(zsobol_ ? zsobol.key(x, y, sample) : ZSobol::Key{}),
         rng_(Rng::for_sample(settings.seed, pixel, sample)) {}
 
-  double get1d(uint32_t dim) { return zsobol_ ? zsobol_->get1d(key_, dim) : rng_.uniform(); }
+  double get1d(uint32_t dim) {
+    return zsobol_ && dim < SampleDims::kStream ? zsobol_->get1d(key_, dim) : rng_.uniform();
+  }
   std::array<double, 2> get2d(uint32_t dim) {
-    if (zsobol_) return zsobol_->get2d(key_, dim);
+    if (zsobol_ && dim < SampleDims::kStream) return zsobol_->get2d(key_, dim);
     const double u1 = rng_.uniform();
     return {u1, rng_.uniform()};
   }
@@ -65,7 +75,7 @@ class PathSampler {
   // The stream's next number is dimension dim's (zsobol; independent: the stream's own), until
   // done() drops it if unused, so that a dimension serves one purpose only.
   void first_from(uint32_t dim) {
-    if (zsobol_) rng_.set_next(get1d(dim));
+    if (zsobol_ && dim < SampleDims::kStream) rng_.set_next(get1d(dim));
   }
   void done() { rng_.clear_next(); }
 

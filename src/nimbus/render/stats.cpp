@@ -21,6 +21,7 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
   const bool spectral = scene.settings.spectral.mode == SpectralSettings::Mode::Spectral;
   j["spectrum"] = {{"mode", name_of(kSpectrumModeNames, scene.settings.spectral.mode)},
                    {"channels", spectral ? scene.settings.spectral.wavelengths : 3}};
+  j["sampler"] = name_of(kSamplerNames, scene.settings.sampler);
   const TrackingSettings& t = scene.settings.tracking;
   j["tracking"] = {{"mode", name_of(kTrackingModeNames, t.mode)},
                    {"absorption", name_of(kAbsorptionNames, t.absorption)},
