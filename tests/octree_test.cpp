@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <cmath>
 #include <vector>
 
 #include "nimbus/frep/bounds.h"
@@ -55,6 +56,16 @@ Scene three_media(int depth) {
   add_field_object(scene, make_shape(std::move(bumpy)), constant);
   build_majorant_octrees(scene);
   return scene;
+}
+
+// Whether the field's walks visit p: they are clipped to where some object's F > 0
+// (medium_field.h), and the minorants need hold only there.
+bool walked(const Scene& scene, const Vec3& p) {
+  for (int i : scene.field_objects) {
+    const SceneObject& obj = scene.objects[i];
+    if (obj.bounds.contains(p) && evaluate(obj.tape, p) > 0) return true;
+  }
+  return false;
 }
 
 // mu_t at p in rgb mode.
@@ -120,7 +131,8 @@ TEST(Octree, ConservativeBoundsContainMuTAtRandomPoints) {
         return;
       }
       for (int c = 0; c < 3; ++c) {
-        EXPECT_LE(node_mu_c(tree, index)[c], mu[c]) << "level " << level << " channel " << c;
+        if (walked(scene, p))
+          EXPECT_LE(node_mu_c(tree, index)[c], mu[c]) << "level " << level << " channel " << c;
         EXPECT_GE(node_mu_bar(tree, index)[c], mu[c]) << "level " << level << " channel " << c;
       }
     });
@@ -131,7 +143,7 @@ TEST(Octree, ConservativeBoundsContainMuTAtRandomPoints) {
 }
 
 // In spectral mode the tree holds bounds per wavelength bin; every wavelength a path can draw
-// is bounded by its bin's, at every level.
+// is bounded by its bin's, at every level (the minorants where the walks go).
 TEST(Octree, SpectralBinsBoundMuTAtTheSampledWavelengths) {
   Scene scene = three_media(6);
   scene.settings.spectral = {SpectralSettings::Mode::Spectral, 8};
@@ -155,7 +167,8 @@ TEST(Octree, SpectralBinsBoundMuTAtTheSampledWavelengths) {
       }
       for (int c = 0; c < 8; ++c) {
         const int b = ps.ch.bin[c];
-        EXPECT_LE(tree.mu_c(index)[b], mu[c]) << "level " << level << " λ " << ps.ch.wl.lambda[c];
+        if (walked(scene, p))
+          EXPECT_LE(tree.mu_c(index)[b], mu[c]) << "level " << level << " λ " << ps.ch.wl.lambda[c];
         EXPECT_GE(tree.mu_bar(index)[b], mu[c]) << "level " << level << " λ " << ps.ch.wl.lambda[c];
       }
     });
@@ -446,6 +459,42 @@ TEST(Octree, ConstantMediumInsideASolidIsOneNode) {
     EXPECT_NEAR(node_mu_bar(scene.solid_octrees[0], 0)[c], m.sigma_s.rgb[c], 1e-9);
     EXPECT_NEAR(node_mu_c(scene.solid_octrees[0], 0)[c], m.sigma_s.rgb[c], 1e-9);
   }
+}
+
+// Issue 13: the field's walk is clipped to where an object's F > 0, its surface found exactly, so
+// a constant medium's tree is one homogeneous node (the minorant holds where the walk goes) and
+// the part of a leaf outside the object costs nothing.
+TEST(Octree, ConstantMediumInTheFieldIsOneNodeWalkedOnlyInside) {
+  Scene scene;
+  scene.settings.tracking.octree_depth = 8;
+  Medium m;
+  m.sigma_s = Rgb({1.0, 2.0, 3.0});
+  add_field_object(scene, make_shape(QuadricNode{sphere({0, 0, 0}, 1)}), m);
+  add_field_object(scene, make_shape(QuadricNode{sphere({3, 0, 0}, 1)}), m);
+  build_majorant_octrees(scene);
+  const MajorantOctree& tree = scene.field_octree;
+  // Two members: where one alone may be present the node is homogeneous; the tree splits only
+  // to separate them.
+  ASSERT_LE(tree.nodes.size(), 9u);
+  const Ray ray{{-2, 0.3, 0}, {1, 0, 0}};
+  const Walked w = walk(scene, ray, 0, 10);
+  const double half_chord = std::sqrt(1 - 0.09);
+  ASSERT_EQ(w.segments.size(), 2u);
+  EXPECT_NEAR(w.segments[0].t0, 2 - half_chord, 1e-12);
+  EXPECT_NEAR(w.segments[0].t1, 2 + half_chord, 1e-12);
+  EXPECT_NEAR(w.segments[1].t0, 5 - half_chord, 1e-12);
+  EXPECT_NEAR(w.segments[1].t1, 5 + half_chord, 1e-12);
+  for (const MajorantSegment<3>& s : w.segments)
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(s.mu_bar[c], m.sigma_s.rgb[c], 1e-9);
+      EXPECT_NEAR(s.mu_c[c], m.sigma_s.rgb[c], 1e-9);
+    }
+  // A ray starting inside the first sphere, and one that misses both.
+  const Walked inside = walk(scene, {{0, 0, 0}, {0, 1, 0}}, 0, 10);
+  ASSERT_EQ(inside.segments.size(), 1u);
+  EXPECT_EQ(inside.segments[0].t0, 0);
+  EXPECT_NEAR(inside.segments[0].t1, 1, 1e-12);
+  EXPECT_TRUE(walk(scene, {{-2, 1.2, 0}, {1, 0, 0}}, 0, 10).segments.empty());
 }
 
 TEST(Octree, MajorantScaleMultipliesTheWalkedMajorants) {

@@ -13,6 +13,7 @@
 #include "nimbus/frep/primitives.h"
 #include "nimbus/media/cloud_density.h"
 #include "nimbus/media/field_density.h"
+#include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
 #include "nimbus/spectral/color.h"
 
@@ -444,6 +445,29 @@ TEST(SceneLoad, FuzzCorpusHoldsEveryBadAndShippedScene) {
       continue;
     }
     EXPECT_EQ(held.str(), text) << path << " (NIMBUS_WRITE_FUZZ_CORPUS=1 writes it)";
+  }
+}
+
+// Issue 13: optical thickness alone costs nothing (the walk is clipped to the exact surface), so a
+// homogeneous gray medium of sigma_t = 10^8 compiles; the same density made chromatic would cost
+// 10^8 null collisions per ray in its thinner channels and is refused, naming the object.
+TEST(SceneLoad, DenseGrayMediaCompileAndDenseChromaticOnesAreRefused) {
+  const std::string sphere =
+      R"({"shape": {"type": "sphere", "radius": 1}, "surface": {"type": "none"},
+                                 "medium": "smoke"})";
+  auto scene = [&](const std::string& sigma_s) {
+    return with_camera(R"("media": {"smoke": {"sigma_s": )" + sigma_s + R"(}}, "objects": [)" +
+                       sphere + "]");
+  };
+  EXPECT_NO_THROW(compile_scene(load(scene("1e8"))));
+  try {
+    compile_scene(load(scene("[1e8, 1e8, 1]")));
+    ADD_FAILURE() << "a chromatic medium of 1e8 compiled";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(
+                  "scene.json: /objects/0/medium: medium \"smoke\" may cost 3.46e+08 null", 0),
+              0u)
+        << e.what();
   }
 }
 

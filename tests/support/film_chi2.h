@@ -40,6 +40,26 @@ inline Chi2 film_chi2(const Film& a, const Film& b) {
   return c;
 }
 
+// As film_chi2 of two renders, over blocks of k × k pixels (the films' sizes multiples of k):
+// each z-score then rests on k² times the samples, which keeps it near normal where single
+// pixels' estimates are heavy-tailed (weighted trackers' rare large weights) and their sample
+// variances too unreliable for the per-pixel sum to be chi-square distributed.
+inline Chi2 film_chi2_blocks(const Film& a, const Film& b, int k) {
+  Chi2 c;
+  for (int by = 0; by + k <= a.height; by += k)
+    for (int bx = 0; bx + k <= a.width; bx += k) {
+      Rgb diff(0.0), var(0.0);
+      for (int y = by; y < by + k; ++y)
+        for (int x = bx; x < bx + k; ++x) {
+          const int p = y * a.width + x;
+          diff += (a.mean(p) - b.mean(p)) / double(k * k);
+          var += (a.variance_of_mean(p) + b.variance_of_mean(p)) / double(k * k * k * k);
+        }
+      for (int ch = 0; ch < 3; ++ch) add_z(c, diff[ch], var[ch]);
+    }
+  return c;
+}
+
 // A render against reference pixel values ref(pixel) (exact, or of negligible error), over the
 // pixels where use(pixel) holds (all by default).
 inline Chi2 film_chi2(const Film& a, const std::function<Rgb(int)>& ref,

@@ -1,9 +1,64 @@
 #include "nimbus/media/medium_field.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace nimbus {
 
 double medium_density(const Medium& medium, const Vec3& x, double F) {
   return medium.scale * medium.density->value(x, F);
+}
+
+bool add_span(MediumIntervals& m, double a, double b) {
+  // Merge every span that overlaps or touches [a, b] into it, then insert it in order.
+  int keep = 0;
+  std::array<std::pair<double, double>, MediumIntervals::kMax> out;
+  bool placed = false;
+  for (int i = 0; i < m.count; ++i) {
+    const auto [lo, hi] = m.spans[i];
+    if (hi < a || lo > b) {
+      if (!placed && lo > b) {
+        if (keep == MediumIntervals::kMax) return false;
+        out[keep++] = {a, b};
+        placed = true;
+      }
+      if (keep == MediumIntervals::kMax) return false;
+      out[keep++] = {lo, hi};
+    } else {
+      a = std::min(a, lo);
+      b = std::max(b, hi);
+    }
+  }
+  if (!placed) {
+    if (keep == MediumIntervals::kMax) return false;
+    out[keep++] = {a, b};
+  }
+  m.spans = out;
+  m.count = keep;
+  return true;
+}
+
+bool add_object_spans(const Tape& tape, const Box& bounds, const Ray& ray, double t0, double t1,
+                      MediumIntervals& m) {
+  double a = t0, b = t1;
+  if (!clip_ray(bounds, ray, a, b) || !(b > a)) return true;
+  // Right after a root, first_hit may find the same root again, a few ulps on (a path that
+  // scatters just inside the surface starts there): the next search starts this far past it.
+  // A stretch is told inside or outside at its midpoint, so only a sliver thinner than this
+  // between two roots could be missed.
+  const double skip = kRootSkip * length(bounds.extent());
+  double t = a;  // the start of the current stretch: t0 or the last root
+  for (int step = 0; step < 4 * MediumIntervals::kMax; ++step) {
+    const double from = step == 0 ? a : t + skip;
+    const std::optional<double> r =
+        from < b ? first_hit(tape, ray, from, b) : std::optional<double>();
+    const double end = r ? std::max(*r, from) : b;
+    if (end > t && evaluate(tape, ray.at(0.5 * (t + end))) > 0 && !add_span(m, t, end))
+      return false;
+    if (!r) return true;
+    t = end;
+  }
+  return add_span(m, t, b);  // more roots than spans allow: keep the rest, conservatively
 }
 
 }  // namespace nimbus

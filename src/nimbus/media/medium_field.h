@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include "nimbus/frep/intersect.h"
+#include "nimbus/math/box.h"
 #include "nimbus/math/ray.h"
 #include "nimbus/media/media_scene.h"
 #include "nimbus/media/medium.h"
@@ -90,10 +92,50 @@ struct MajorantSegment {
   Spectrum<N> mu_c{0.0};
 };
 
+// Where the field's media can be along a ray: the stretches of [t_min, t_max] where some
+// index-matched medium object's F > 0, found from the exact roots of F along the ray (its
+// surface, frep/intersect.h), sorted and disjoint. Surfaces are exact, so an octree leaf that
+// straddles an object's boundary costs nothing outside it.
+struct MediumIntervals {
+  static constexpr int kMax = 32;
+  int count = 0;
+  std::array<std::pair<double, double>, kMax> spans;
+};
+
+// How far past a root, relative to the object's size, the search for the next one starts
+// (add_object_spans).
+inline constexpr double kRootSkip = 1e-9;
+
+// Adds [a, b] to sorted disjoint spans, merging overlaps. False when there is no room left.
+bool add_span(MediumIntervals& m, double a, double b);
+
+// The object's stretches with F > 0 over [t0, t1] (within its bounds), added to m. False when m
+// ran out of room.
+bool add_object_spans(const Tape& tape, const Box& bounds, const Ray& ray, double t0, double t1,
+                      MediumIntervals& m);
+
+template <MediumHolders S>
+MediumIntervals field_medium_intervals(const S& scene, const Ray& ray, double t_min, double t_max) {
+  MediumIntervals m;
+  for (int i : scene.field_objects) {
+    const auto& obj = scene.objects[i];
+    if (!add_object_spans(obj.tape, obj.bounds, ray, t_min, t_max, m)) {
+      // More stretches than kMax (a very wiggly surface): track the whole ray; the lookups
+      // find no medium where there is none.
+      m.count = 1;
+      m.spans[0] = {t_min, t_max};
+      return m;
+    }
+  }
+  return m;
+}
+
 // Calls f(const MajorantSegment<N>&) for the majorant segments covering the media along the ray
 // in [t_min, t_max], in order, from the leaves of the scene's majorant octree (octree.h) for
 // `inside` (-1: the field; else that solid object), each channel taking its bin's bounds. Where
-// no medium can be there is a gap; neighbouring leaves with identical bounds become one segment.
+// no medium can be there is a gap: in the field, the leaves' stretches are clipped to where an
+// object's F > 0 (field_medium_intervals), which the octree's minorants rely on; inside a solid
+// the ray never leaves the object. Neighbouring leaves with identical bounds become one segment.
 // f returns false to stop the walk. The ray direction must be unit length.
 template <int N, MediaScene S, class F>
 void walk_majorant_segments(const S& scene, const Channels<N>& ch, const Ray& ray, double t_min,
@@ -101,28 +143,52 @@ void walk_majorant_segments(const S& scene, const Channels<N>& ch, const Ray& ra
   if (inside >= 0 && scene.objects[inside].medium < 0) return;  // a solid without a medium
   // at(): a scene whose octrees were never built fails loudly rather than reading past the end.
   const MajorantOctree& tree = inside >= 0 ? scene.solid_octrees.at(inside) : scene.field_octree;
+  if (tree.nodes.empty()) return;
+  MediumIntervals spans;
+  if (inside >= 0) {
+    spans.count = 1;
+    spans.spans[0] = {t_min, t_max};
+  } else {
+    double t0 = t_min, t1 = t_max;
+    if (!clip_ray(tree.box, ray, t0, t1) || !(t1 > t0)) return;
+    spans = field_medium_intervals(scene, ray, t0, t1);
+    if (spans.count == 0) return;
+  }
   const double scale = tree.majorant_scale;
   MajorantSegment<N> pending{0, 0, Spectrum<N>(0.0), Spectrum<N>(0.0)};
   bool has_pending = false;
-  const bool finished =
-      walk_octree(tree, ray, t_min, t_max, [&](std::int32_t node, double a, double b) {
-        const double* hi = tree.mu_bar(node);
-        const double* lo = tree.mu_c(node);
-        Spectrum<N> mu_bar, mu_c;
-        for (int c = 0; c < N; ++c) {
-          mu_bar[c] = hi[ch.bin[c]] * scale;
-          mu_c[c] = lo[ch.bin[c]];
-        }
-        if (has_pending && a == pending.t1 && mu_bar == pending.mu_bar && mu_c == pending.mu_c) {
-          pending.t1 = b;
-          return true;
-        }
-        if (has_pending && !f(std::as_const(pending))) return false;
-        pending = {a, b, mu_bar, mu_c};
-        has_pending = true;
-        return true;
-      });
-  if (finished && has_pending) f(std::as_const(pending));
+  int span = 0;          // the first span that may overlap the current leaf
+  bool stopped = false;  // f asked to stop
+  auto emit = [&](double a, double b, const Spectrum<N>& mu_bar, const Spectrum<N>& mu_c) {
+    if (has_pending && a == pending.t1 && mu_bar == pending.mu_bar && mu_c == pending.mu_c) {
+      pending.t1 = b;
+      return true;
+    }
+    if (has_pending && !f(std::as_const(pending))) return !(stopped = true);
+    pending = {a, b, mu_bar, mu_c};
+    has_pending = true;
+    return true;
+  };
+  walk_octree(tree, ray, spans.spans[0].first, spans.spans[spans.count - 1].second,
+              [&](std::int32_t node, double a, double b) {
+                while (span < spans.count && spans.spans[span].second <= a) ++span;
+                if (span == spans.count) return false;
+                if (spans.spans[span].first >= b) return true;
+                const double* hi = tree.mu_bar(node);
+                const double* lo = tree.mu_c(node);
+                Spectrum<N> mu_bar, mu_c;
+                for (int c = 0; c < N; ++c) {
+                  mu_bar[c] = hi[ch.bin[c]] * scale;
+                  mu_c[c] = lo[ch.bin[c]];
+                }
+                for (int k = span; k < spans.count && spans.spans[k].first < b; ++k)
+                  if (!emit(std::max(a, spans.spans[k].first), std::min(b, spans.spans[k].second),
+                            mu_bar, mu_c))
+                    return false;
+                return true;
+              });
+  // The walk also stops once past the last span; a pending segment is then still due.
+  if (!stopped && has_pending) f(std::as_const(pending));
 }
 
 // The mixture phase function at a scattering point: value per channel.

@@ -47,20 +47,20 @@ std::vector<std::vector<double>> sigma_t_bins(std::span<const Medium> media, boo
   return out;
 }
 
-// The density range of one member over a box, from the interval of F. Inside a solid the medium
-// fills the object wherever the ray can be.
-bool density_range(const Member& m, const Box& box, bool solid, double& lo, double& hi) {
+// The density range of one member over a box, from the interval of F. `only_inside`: the walks
+// visit only points where F > 0 (inside a solid, the ray stays in the object; in the field, the
+// walk is clipped to where some member's F > 0, medium_field.h), so the minorant need hold there
+// only; else it must hold over the whole box, where the medium is absent wherever F <= 0 or
+// outside the object's bounds.
+bool density_range(const Member& m, const Box& box, bool only_inside, double& lo, double& hi) {
   const Box b = intersect(m.object->bounds, box);
   if (b.empty()) return false;  // medium_at only looks at objects whose bounds hold the point
   const Interval F = evaluate(*m.object->tape, b);
   if (!(F.hi > 0)) return false;
   const Medium& med = *m.medium;
   const Interval r = med.density->range(b, F);
-  // Outside a solid the medium is present only where F > 0.
-  lo = solid || F.lo > 0 ? med.scale * r.lo : 0.0;
+  lo = only_inside || (F.lo > 0 && b.lo == box.lo && b.hi == box.hi) ? med.scale * r.lo : 0.0;
   hi = med.scale * r.hi;
-  // Where the box reaches past the object's bounds there are points without this medium.
-  if (!(b.lo == box.lo && b.hi == box.hi)) lo = 0;
   return true;
 }
 
@@ -74,11 +74,18 @@ constexpr double kRoundOff = 1e-12;
 bool interval_bounds(const std::vector<Member>& members, const Box& box, bool solid, int bins,
                      double* out) {
   std::fill(out, out + 2 * bins, 0.0);
+  // Where one member alone may be present, the clipped walk sees only its inside; where several
+  // may, a point inside one of them can be outside another.
+  int present = 0;
+  for (const Member& m : members) {
+    const Box b = intersect(m.object->bounds, box);
+    present += !b.empty() && evaluate(*m.object->tape, b).hi > 0;
+  }
   bool any = false;
   for (const Member& m : members) {
     double lo = 0, hi = 0;
     // A density bounded by 0 (a cloud eroded away near its surface) is no medium either.
-    if (!density_range(m, box, solid, lo, hi) || !(hi > 0)) continue;
+    if (!density_range(m, box, solid || present == 1, lo, hi) || !(hi > 0)) continue;
     for (int b = 0; b < bins; ++b) {
       out[b] += m.sigma_t_hi[b] * hi;
       out[bins + b] += m.sigma_t_lo[b] * lo;

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "nimbus/frep/bounds.h"
@@ -94,6 +95,27 @@ double optical_thickness_bound(const Scene& scene, const SceneObject& obj) {
   return m.scale * density.hi * sigma_t * length(obj.bounds.extent());
 }
 
+// An upper bound on the null collisions along a ray across an object, what tracking costs where
+// the optical thickness itself is large: the largest null rate of the object's majorant octree
+// (the largest majorant of any bin, the walk's scale included, minus the smallest minorant, over
+// every non-empty leaf; rgb trackers take the largest channel's rate), times the bounds'
+// diagonal. Real collisions end a path (absorption, max_depth) and a shadow ray (its first
+// lookup through a homogeneous medium), so a gray medium of any density costs little.
+double null_thickness_bound(const Scene& scene, size_t object) {
+  const SceneObject& obj = scene.objects[object];
+  const MajorantOctree& tree =
+      obj.surface.type == Surface::Type::None ? scene.field_octree : scene.solid_octrees.at(object);
+  double rate = 0;
+  for (size_t i = 0; i < tree.nodes.size(); ++i) {
+    if (tree.nodes[i].children >= 0 || tree.nodes[i].empty) continue;
+    const double* hi = tree.mu_bar(i);
+    const double* lo = tree.mu_c(i);
+    const double top = *std::max_element(hi, hi + tree.bins) * std::max(1.0, tree.majorant_scale);
+    rate = std::max(rate, top - *std::min_element(lo, lo + tree.bins));
+  }
+  return rate * length(obj.bounds.extent());
+}
+
 }  // namespace
 
 Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor) {
@@ -143,11 +165,13 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor) {
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const SceneObject& obj = scene.objects[i];
     if (obj.medium < 0) continue;
-    const double tau = optical_thickness_bound(scene, obj);
+    if (optical_thickness_bound(scene, obj) <= kMaxOpticalThickness) continue;
+    const double tau = null_thickness_bound(scene, i);
     if (!(tau <= kMaxOpticalThickness))
       throw SceneError(fmt::format(
-          "{}: {}/medium: medium \"{}\" may reach an optical thickness of {:.3g} across the "
-          "object; at most {:.0e} is supported (tracking takes about that many steps per ray)",
+          "{}: {}/medium: medium \"{}\" may cost {:.3g} null collisions along a ray across the "
+          "object; at most {:.0e} are supported (a heterogeneous or chromatic medium this dense "
+          "would render as if hung)",
           desc.source, object_descs[i]->json_path, desc.media[obj.medium].name, tau,
           kMaxOpticalThickness));
   }

@@ -7,14 +7,17 @@
 
 namespace nimbus {
 
-// The largest optical thickness (an upper bound of sigma_t · density across an object's bounds)
-// that a scene file may give a medium. Tracking takes about that many steps along a ray, so a
-// larger one would look like a hang; realistic media stay far below (a 1 km cloud at 100 /m:
-// 10^5; skin at 40 /mm over 10 cm: 4 · 10^3).
+// The largest number of null collisions along a ray across an object (an upper bound from its
+// majorant octree: null rate times the object's size) that a scene file may give a medium whose
+// optical thickness is above it. Tracking takes about that many steps along a ray, so more would
+// look like a hang; realistic media stay far below (a 1 km cloud at 100 /m: 10^5; skin at 40 /mm
+// over 10 cm: 4 · 10^3). A medium optically thicker but homogeneous and gray costs its real
+// collisions only: the walk is clipped to the object's surface, its octree node has no null rate.
 inline constexpr double kMaxOpticalThickness = 1e6;
 
 // Throws SceneError (one line, with the JSON path) for what only compilation can see, such as an
-// object whose shape is unbounded or a medium above kMaxOpticalThickness.
+// object whose shape is unbounded or a medium that may cost more than kMaxOpticalThickness null
+// collisions per ray.
 // The monitor watches the majorant octrees' build, the part that can take seconds
 // (media/octree.h); a cancelled compile returns a scene that must not be rendered.
 Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor = {});
