@@ -131,8 +131,9 @@ TEST(Octree, ConservativeBoundsContainMuTAtRandomPoints) {
         return;
       }
       for (int c = 0; c < 3; ++c) {
-        if (walked(scene, p))
+        if (walked(scene, p)) {
           EXPECT_LE(node_mu_c(tree, index)[c], mu[c]) << "level " << level << " channel " << c;
+        }
         EXPECT_GE(node_mu_bar(tree, index)[c], mu[c]) << "level " << level << " channel " << c;
       }
     });
@@ -167,8 +168,9 @@ TEST(Octree, SpectralBinsBoundMuTAtTheSampledWavelengths) {
       }
       for (int c = 0; c < 8; ++c) {
         const int b = ps.ch.bin[c];
-        if (walked(scene, p))
+        if (walked(scene, p)) {
           EXPECT_LE(tree.mu_c(index)[b], mu[c]) << "level " << level << " λ " << ps.ch.wl.lambda[c];
+        }
         EXPECT_GE(tree.mu_bar(index)[b], mu[c]) << "level " << level << " λ " << ps.ch.wl.lambda[c];
       }
     });
