@@ -85,20 +85,49 @@ TEST(WorkQueue, HandsOutEverySampleOnceInOrderPerLane) {
   EXPECT_THROW(WorkQueue(film, spp - 1, 3, 1, 1), std::invalid_argument);
 }
 
-TEST(WorkQueue, AbandonedUnitsComeBackAndStopEndsTheHandingOut) {
-  WorkQueue queue(Film(4, 4), 2, 4, 1, 1);
-  const auto u = queue.try_next();
-  ASSERT_TRUE(u);
-  EXPECT_FALSE(queue.try_next());  // one lane, already out
-  queue.abandon(*u);
+// One lane (a dense region) keeps several units out at once; a result that comes before an
+// earlier one of its lane waits for it, and a unit given back is handed out again.
+TEST(WorkQueue, UnitsOfOneLaneMayBeOutTogetherAndComeBackInAnyOrder) {
+  WorkQueue queue(Film(4, 4), 3, 4, 2, 1);
+  auto unit_film = [](const WorkUnit& u) {
+    Film f(4, 4);
+    for (int p = 0; p < 16; ++p)
+      for (int s = u.s0; s < u.s1; ++s) f.add(p, Rgb(double(1 << s)));
+    return take_patch(f, u.rect);
+  };
+  const auto a = queue.try_next(), b = queue.try_next(), c = queue.try_next();
+  ASSERT_TRUE(a && b && c);
+  EXPECT_EQ(a->s0, 0);
+  EXPECT_EQ(b->s0, 1);
+  EXPECT_EQ(c->s0, 2);
+  EXPECT_FALSE(queue.try_next());  // every sample is out
+  queue.complete(1, *c, unit_film(*c), 0.1, {});
+  queue.complete(0, *b, unit_film(*b), 0.1, {});
+  EXPECT_EQ(queue.film().samples[0], 0u);  // samples 1 and 2 wait for sample 0
+  EXPECT_THROW(queue.complete(0, *b, unit_film(*b), 0.1, {}), std::invalid_argument);
+  queue.abandon(*a);
   const auto again = queue.try_next();
   ASSERT_TRUE(again);
   EXPECT_EQ(again->s0, 0);
-  queue.abandon(*again);
+  EXPECT_EQ(again->s1, 1);
+  EXPECT_FALSE(queue.finished());
+  queue.complete(1, *again, unit_film(*again), 0.1, {});
+  EXPECT_TRUE(queue.finished());
+  const Film film = queue.film();
+  EXPECT_EQ(film.samples[5], 3u);
+  EXPECT_EQ(film.mean(5)[0], 7.0 / 3);  // (1 + 2 + 4) / 3
+}
+
+TEST(WorkQueue, StopEndsTheHandingOut) {
+  WorkQueue queue(Film(4, 4), 2, 4, 1, 1);
+  const auto u = queue.try_next();
+  ASSERT_TRUE(u);
+  queue.abandon(*u);
   queue.stop();
   EXPECT_FALSE(queue.try_next());
   EXPECT_FALSE(queue.wait_next());
   EXPECT_FALSE(queue.finished());
+  EXPECT_TRUE(queue.none_out());
 }
 
 TEST(Checkpoint, SavedAndLoadedBitForBit) {

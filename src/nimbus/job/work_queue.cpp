@@ -39,7 +39,10 @@ WorkQueue::WorkQueue(Film start, int spp, int band_height, int ranks, double uni
     if (held > uint32_t(spp))
       throw std::invalid_argument(fmt::format(
           "pixel ({}, {}) already holds {} samples, more than {}", r.x0, r.y0, held, spp));
-    lanes_.push_back({r, int(held)});
+    Lane lane;
+    lane.rect = r;
+    lane.done = lane.issued = int(held);
+    lanes_.push_back(std::move(lane));
     total_ += double(r.pixels()) * (spp - int(held));
   }
 }
@@ -47,18 +50,25 @@ WorkQueue::WorkQueue(Film start, int spp, int band_height, int ranks, double uni
 std::optional<WorkUnit> WorkQueue::next_locked() {
   if (stopped_) return std::nullopt;
   Lane* best = nullptr;
-  for (Lane& l : lanes_)
-    if (!l.out && l.done < spp_ && (!best || l.done < best->done)) best = &l;
+  for (Lane& l : lanes_) {
+    if (!l.given_back.empty()) {
+      const auto [s0, s1] = l.given_back.back();
+      l.given_back.pop_back();
+      ++out_;
+      return WorkUnit{l.rect, s0, s1, int(&l - lanes_.data())};
+    }
+    if (l.issued < spp_ && (!best || l.issued < best->issued)) best = &l;
+  }
   if (!best) return std::nullopt;
   int chunk = 1;
   if (best->seconds_per_sample > 0)
     chunk = std::clamp(int(unit_seconds_ / best->seconds_per_sample), 1,
                        std::max(1, 4 * best->last_chunk));
-  chunk = std::min(chunk, spp_ - best->done);
-  best->out = true;
+  chunk = std::min(chunk, spp_ - best->issued);
   best->last_chunk = chunk;
+  best->issued += chunk;
   ++out_;
-  return WorkUnit{best->rect, best->done, best->done + chunk, int(best - lanes_.data())};
+  return WorkUnit{best->rect, best->issued - chunk, best->issued, int(best - lanes_.data())};
 }
 
 std::optional<WorkUnit> WorkQueue::try_next() {
@@ -79,13 +89,18 @@ void WorkQueue::complete(int rank, const WorkUnit& unit, const FilmPatch& result
                          const Counters& counters) {
   std::lock_guard lock(mutex_);
   Lane& lane = lanes_.at(unit.lane);
-  if (!lane.out || lane.done != unit.s0 || result.rect.x0 != lane.rect.x0 ||
+  if (out_ == 0 || unit.s0 < lane.done || unit.s1 > lane.issued || unit.s0 >= unit.s1 ||
+      lane.waiting.contains(unit.s0) || result.rect.x0 != lane.rect.x0 ||
       result.rect.y0 != lane.rect.y0 || result.rect.x1 != lane.rect.x1 ||
       result.rect.y1 != lane.rect.y1)
     throw std::invalid_argument("a result for a unit that is not out");
-  merge_patch(film_, result);
-  lane.done = unit.s1;
-  lane.out = false;
+  lane.waiting[unit.s0] = {unit.s1, result};
+  for (auto next = lane.waiting.find(lane.done); next != lane.waiting.end();
+       next = lane.waiting.find(lane.done)) {
+    merge_patch(film_, next->second.patch);
+    lane.done = next->second.s1;
+    lane.waiting.erase(next);
+  }
   lane.seconds_per_sample = seconds / (unit.s1 - unit.s0);
   --out_;
   const double added = double(lane.rect.pixels()) * (unit.s1 - unit.s0);
@@ -97,11 +112,8 @@ void WorkQueue::complete(int rank, const WorkUnit& unit, const FilmPatch& result
 
 void WorkQueue::abandon(const WorkUnit& unit) {
   std::lock_guard lock(mutex_);
-  Lane& lane = lanes_.at(unit.lane);
-  if (lane.out) {
-    lane.out = false;
-    --out_;
-  }
+  lanes_.at(unit.lane).given_back.emplace_back(unit.s0, unit.s1);
+  if (out_ > 0) --out_;
   changed_.notify_all();
 }
 

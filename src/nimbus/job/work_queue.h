@@ -5,17 +5,19 @@
 // and every pixel then holds its samples [0, n) for some n.
 //
 // The image is cut into lanes: bands of rows whose pixels hold the same number of samples (a
-// film from a checkpoint of another band layout is cut into row runs of equal count). A lane
-// has at most one unit out at a time, so its units are merged in sample order; the next unit
-// goes to the lane with the fewest samples, so lanes advance together and the last units are
-// short. A lane's first unit is one sample; later ones are sized from its measured cost to take
-// about `unit_seconds`, so a costly lane (a dense cloud) gets short units and the others long
-// ones. Pixels are the same bits however units fall to threads or processes: sums are exact
-// (render/exact_sum.h).
+// film from a checkpoint of another band layout is cut into row runs of equal count). The next
+// unit goes to the lane with the fewest samples handed out, so lanes advance together and the
+// last units are short; several units of one lane may be out at once (a dense cloud covering
+// few lanes still keeps every rank busy), and a result that arrives before an earlier one of
+// its lane waits until the lane's film catches up, so the film's lanes grow in sample order. A
+// lane's first unit is one sample; later ones are sized from its measured cost to take about
+// `unit_seconds`, so a costly lane gets short units and the others long ones. Pixels are the
+// same bits however units fall to threads or processes: sums are exact (render/exact_sum.h).
 
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <vector>
@@ -43,7 +45,7 @@ class WorkQueue {
   // for samples_per_rank.
   WorkQueue(Film start, int spp, int band_height, int ranks, double unit_seconds);
 
-  // The next unit, or none when every lane is done or has a unit out, or after stop().
+  // The next unit, or none when every sample is handed out, or after stop().
   std::optional<WorkUnit> try_next();
   // Waits for the next unit; none once the job is finished or stopped.
   std::optional<WorkUnit> wait_next();
@@ -65,10 +67,16 @@ class WorkQueue {
   std::vector<uint64_t> samples_per_rank() const;  // pixel samples each rank rendered
 
  private:
+  struct Result {
+    int s1 = 0;
+    FilmPatch patch;
+  };
   struct Lane {
     PixelRect rect;
-    int done = 0;  // samples every pixel of the lane holds
-    bool out = false;
+    int done = 0;    // samples every pixel of the lane holds in the film: [0, done)
+    int issued = 0;  // samples handed out: [done, issued) are out, given back or waiting
+    std::vector<std::pair<int, int>> given_back;  // sample ranges to hand out again
+    std::map<int, Result> waiting;                // results ahead of `done`, by their s0
     int last_chunk = 0;
     double seconds_per_sample = 0;  // of the whole lane, measured; 0: not yet
   };
