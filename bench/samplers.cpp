@@ -10,7 +10,8 @@
 // PathSampler per pixel sample drawing the camera's, the wavelength's and 8 bounces' dimensions.
 // Output: Markdown.
 //
-// Usage: samplers [--spp N] [--ref-spp N] [--reps N] [--width N] [scene.json ...]
+// Usage: samplers [--spp N] [--ref-spp N] [--reps N] [--width N] [--set KEY=VALUE]...
+//                 [scene.json ...]
 // Defaults: 16 spp, reference 1024 spp, 5 repetitions, width 48, scenes/cloud.json.
 
 #include <algorithm>
@@ -33,11 +34,12 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-Scene sized_scene(const std::string& path, int width, int spp, uint64_t seed,
-                  const std::string& sampler) {
-  SceneDesc desc = load_scene_file(
-      path, {"integrator.spp=" + std::to_string(spp), "integrator.seed=" + std::to_string(seed),
-             "integrator.sampler=\"" + sampler + "\""});
+Scene sized_scene(const std::string& path, std::vector<std::string> overrides, int width, int spp,
+                  uint64_t seed, const std::string& sampler) {
+  overrides.push_back("integrator.spp=" + std::to_string(spp));
+  overrides.push_back("integrator.seed=" + std::to_string(seed));
+  overrides.push_back("integrator.sampler=\"" + sampler + "\"");
+  SceneDesc desc = load_scene_file(path, overrides);
   desc.film.height = std::max(1, desc.film.height * width / desc.film.width);
   desc.film.width = width;
   return compile_scene(desc);
@@ -77,7 +79,7 @@ double sampler_ns_per_sample(RenderSettings::Sampler kind, int bounces) {
 
 int main(int argc, char** argv) {
   int spp = 16, ref_spp = 1024, reps = 5, width = 48;
-  std::vector<std::string> scenes;
+  std::vector<std::string> scenes, overrides;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--spp" && i + 1 < argc)
@@ -88,6 +90,8 @@ int main(int argc, char** argv) {
       reps = std::stoi(argv[++i]);
     else if (a == "--width" && i + 1 < argc)
       width = std::stoi(argv[++i]);
+    else if (a == "--set" && i + 1 < argc)
+      overrides.push_back(argv[++i]);
     else
       scenes.push_back(a);
   }
@@ -100,8 +104,8 @@ int main(int argc, char** argv) {
       "s/sample zsobol | efficiency zsobol / independent |\n");
   std::printf("|---|---|---|---|---|---|---|\n");
   for (const std::string& path : scenes) {
-    const RenderResult ref =
-        render(sized_scene(path, width, ref_spp, 987654321, "independent"), RenderOptions{});
+    const RenderResult ref = render(
+        sized_scene(path, overrides, width, ref_spp, 987654321, "independent"), RenderOptions{});
     double ref_var = 0;
     const int pixels = ref.film.pixels();
     for (int p = 0; p < pixels; ++p)
@@ -110,7 +114,7 @@ int main(int argc, char** argv) {
     const char* names[2] = {"independent", "zsobol"};
     for (int rep = 0; rep < reps; ++rep)
       for (int k = 0; k < 2; ++k) {
-        const Scene scene = sized_scene(path, width, spp, uint64_t(rep + 1), names[k]);
+        const Scene scene = sized_scene(path, overrides, width, spp, uint64_t(rep + 1), names[k]);
         const RenderResult r = render(scene, one_thread);
         double se = 0;
         for (int p = 0; p < pixels; ++p) {

@@ -74,6 +74,18 @@ constexpr std::array<uint64_t, 64> pascal_columns() {
 }
 inline constexpr auto kPascalColumns = pascal_columns();
 
+// The same columns xored together for every value of each byte of the index: eight lookups
+// instead of one per set bit.
+constexpr std::array<std::array<uint64_t, 256>, 8> pascal_byte_tables() {
+  std::array<std::array<uint64_t, 256>, 8> t{};
+  for (int byte = 0; byte < 8; ++byte)
+    for (int v = 0; v < 256; ++v)
+      for (int bit = 0; bit < 8; ++bit)
+        if (v & (1 << bit)) t[byte][v] ^= kPascalColumns[8 * byte + bit];
+  return t;
+}
+inline constexpr auto kPascalBytes = pascal_byte_tables();
+
 }  // namespace zsobol_detail
 
 // The Sobol' point of index i in Sobol's dimension 0 (van der Corput) and 1, as reversed
@@ -83,7 +95,7 @@ constexpr uint64_t sobol0_reversed(uint64_t i) {
 }
 constexpr uint64_t sobol1_reversed(uint64_t i) {
   uint64_t v = 0;
-  for (; i != 0; i &= i - 1) v ^= zsobol_detail::kPascalColumns[std::countr_zero(i)];
+  for (int byte = 0; i != 0; ++byte, i >>= 8) v ^= zsobol_detail::kPascalBytes[byte][i & 0xff];
   return v;
 }
 

@@ -38,7 +38,7 @@ struct SampleDims {
   // Bounces from kBounces on draw from the path's stream: a sampler's number costs about ten
   // of the stream's, and stratification gains little that deep, while dense media make paths of
   // hundreds of bounces. Their dimensions are kStream and above.
-  static constexpr int kBounces = 8;
+  static constexpr int kBounces = 4;
   static constexpr uint32_t kStream = 0x80000000u;
 
   // The first dimension of bounce `depth` (0 at the camera ray's end) with `lights` lights.
