@@ -47,8 +47,17 @@ void cluster_abort(int code) {
   std::exit(code);
 }
 
+// A large message waits for the receiver to post its receive: MPI_Send would spin meanwhile, on
+// a worker whose pixels wait for rank 0's next poll, so the wait sleeps instead.
 void cluster_send(int to, int tag, std::span<const std::byte> bytes) {
-  MPI_Send(bytes.data(), int(bytes.size()), MPI_BYTE, to, tag, MPI_COMM_WORLD);
+  MPI_Request request;
+  MPI_Isend(bytes.data(), int(bytes.size()), MPI_BYTE, to, tag, MPI_COMM_WORLD, &request);
+  for (;;) {
+    int done = 0;
+    MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+    if (done) return;
+    std::this_thread::sleep_for(kPollInterval);
+  }
 }
 
 namespace {
