@@ -116,6 +116,34 @@ TEST(RatioTracking, MatchesAnalyticTransmittance) {
   }
 }
 
+// Issue 13: roulette on the contribution (transmittance_roulette with a weight) keeps every
+// channel's estimate unbiased, whatever the weights, and stops the walk sooner when the weight
+// sits on the channel the medium attenuates most (the thinner channels' large T no longer keeps
+// it going).
+TEST(RatioTracking, RouletteOnTheContributionIsUnbiasedAndStopsSooner) {
+  for (const Profile& p : profiles()) {
+    const Rgb T = p.transmittance();
+    int dense = 0;
+    for (int c = 1; c < 3; ++c)
+      if (T[c] < T[dense]) dense = c;
+    Rgb weight(1e-3);
+    weight[dense] = 1;
+    Rng rng(104);
+    TrackingCounters plain, weighted;
+    const auto z = z_scores(
+        [&] {
+          return ratio_tracking<3>([&](double t) { return p.at(t); }, kT0, kT1, p.majorant(), rng,
+                                   weighted, Rgb(1.0), &weight);
+        },
+        T, kEstimates);
+    for (int c = 0; c < 3; ++c) EXPECT_LT(z[c], 4) << p.name << " ch " << c;
+    for (int i = 0; i < kEstimates; ++i)
+      ratio_tracking<3>([&](double t) { return p.at(t); }, kT0, kT1, p.majorant(), rng, plain);
+    // Every profile is chromatic (T from 0.04 to 0.55): measured 30–70 % fewer lookups.
+    EXPECT_LT(weighted.lookups, plain.lookups) << p.name;
+  }
+}
+
 TEST(RatioTracking, DetectsAFivePercentBias) {
   // The 4-standard-error check has the power to reject a lookup that is 5% too dense.
   const Profile p = profiles()[2];

@@ -56,8 +56,8 @@ class PlainTracking {
   bool light_term(const Scene& scene, const PathSpectra<N>& ps, const Ray& shadow, double t_max,
                   int light, int inside, const LightSample& ls, const Spectrum<N>& fLi, Pdf&& f_pdf,
                   Rng& rng, Counters& counters, Spectrum<N>& out) const {
-    const Spectrum<N> T =
-        transmittance(scene, ps, shadow, t_max, light, inside, channel_, boost_, rng, counters);
+    const Spectrum<N> T = transmittance(scene, ps, shadow, t_max, light, inside, channel_, boost_,
+                                        beta_ * fLi, rng, counters);
     if (T.is_black()) return false;
     out = ls.delta ? fLi * T : fLi * T * (power_heuristic(ls.pdf, f_pdf(ls.wi)) / ls.pdf);
     return true;

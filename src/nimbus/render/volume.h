@@ -164,11 +164,13 @@ MediumEvent<N> sample_collision_mis(const Scene& scene, const PathSpectra<N>& ps
 // block), or -1. `channel` >= 0 (delta tracking once it has chosen its channel): the path's
 // throughput is in that channel alone, so only it is tracked, at its own majorant, with
 // roulette on its own estimate; the other channels come back 0. -1: every channel, at the
-// largest majorant. The majorants are multiplied by the path's `boost`.
+// largest majorant. The majorants are multiplied by the path's `boost`. `weight` is what multiplies
+// T in the contribution (throughput times the scattering function and the light): Russian
+// roulette plays on the share of it that T still carries (transmittance_roulette).
 template <int N>
 Spectrum<N> transmittance(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray,
-                          double t_max, int light, int inside, int channel, double boost, Rng& rng,
-                          Counters& counters) {
+                          double t_max, int light, int inside, int channel, double boost,
+                          const Spectrum<N>& weight, Rng& rng, Counters& counters) {
   ++counters.shadow_rays;
   if (occluded(scene, ray, t_max, light)) return Spectrum<N>(0.0);
   auto lookup = [&](double t) {
@@ -187,10 +189,10 @@ Spectrum<N> transmittance(const Scene& scene, const PathSpectra<N>& ps, const Ra
       Spectrum<N> gap;
       for (int c = 0; c < N; ++c) gap[c] = std::abs(boost * seg.mu_bar[c] - seg.mu_c[c]);
       T = residual_ratio_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_c, tracked_max(gap), rng,
-                                     counters.tracking, T);
+                                     counters.tracking, T, &weight);
     } else {
       T = ratio_tracking<N>(lookup, seg.t0, seg.t1, boost * tracked_max(seg.mu_bar), rng,
-                            counters.tracking, T);
+                            counters.tracking, T, &weight);
     }
     return !T.is_black();
   });

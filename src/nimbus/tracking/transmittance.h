@@ -24,13 +24,25 @@ namespace nimbus {
 // Below this, a transmittance estimate plays Russian roulette (transmittance_roulette).
 inline constexpr double kRouletteThreshold = 0.1;
 
-// Russian roulette on a transmittance estimate T: once max|T| < kRouletteThreshold, T survives
-// with probability q = max|T| / kRouletteThreshold and is divided by q, else it becomes 0.
-// E[T] is unchanged, and a shadow ray through a dense medium stops after a few more collisions
-// instead of walking to its end. Returns false when T was set to 0.
+// Russian roulette on a transmittance estimate T: once its share m of the contribution it can
+// still make falls below kRouletteThreshold, T survives with probability q = m /
+// kRouletteThreshold and is divided by q, else it becomes 0. E[T] is unchanged, and a shadow
+// ray through a dense medium stops after a few more collisions instead of walking to its end.
+// m is max|T| without a weight; with one (what multiplies T in the contribution: the path's
+// throughput times the scattering function and the light, per channel) it is
+// Σ|w T| / Σ|w|, so a channel that carries little of the contribution cannot keep the walk
+// going alone (issue 13). Returns false when T was set to 0.
 template <int N>
-bool transmittance_roulette(Spectrum<N>& T, Rng& rng) {
-  const double m = T.max_abs();
+bool transmittance_roulette(Spectrum<N>& T, Rng& rng, const Spectrum<N>* weight = nullptr) {
+  double m = T.max_abs();
+  if (weight) {
+    double wT = 0, w = 0;
+    for (int c = 0; c < N; ++c) {
+      wT += std::abs((*weight)[c] * T[c]);
+      w += std::abs((*weight)[c]);
+    }
+    if (w > 0) m = wT / w;
+  }
   if (m >= kRouletteThreshold) return true;
   const double q = m / kRouletteThreshold;
   if (rng.uniform() < q) {
@@ -44,17 +56,19 @@ bool transmittance_roulette(Spectrum<N>& T, Rng& rng) {
 // Ratio tracking (Cramer 1978; Novák, Selle & Jarosz 2014): T ≈ Π_i (1 − mu_t(t_i)/mu_bar).
 // mu_bar > 0; with mu_bar <= 0 no collision is sampled and T_in is returned, which is exact only
 // where the segment is empty. T_in is the estimate over the ray's earlier segments: the result is
-// T_in times this segment's, with Russian roulette on the running product.
+// T_in times this segment's, with Russian roulette on the running product (on its share of the
+// contribution when `weight` is given: transmittance_roulette).
 template <int N, class Lookup>
 Spectrum<N> ratio_tracking(Lookup&& lookup, double t0, double t1, double mu_bar, Rng& rng,
-                           TrackingCounters& counters, const Spectrum<N>& T_in = Spectrum<N>(1.0)) {
+                           TrackingCounters& counters, const Spectrum<N>& T_in = Spectrum<N>(1.0),
+                           const Spectrum<N>* weight = nullptr) {
   Spectrum<N> T = T_in;
   track_tentative_collisions(lookup, t0, t1, mu_bar, rng, counters,
                              [&](double, const MediumSample<N>& m) {
                                const double needed = largest_carried(m.mu_t(), T);
                                T *= Spectrum<N>(1.0) - m.mu_t() / mu_bar;
                                raise_majorant(mu_bar, needed, counters);
-                               return !T.is_black() && transmittance_roulette(T, rng);
+                               return !T.is_black() && transmittance_roulette(T, rng, weight);
                              });
   return T;
 }
@@ -67,7 +81,8 @@ Spectrum<N> ratio_tracking(Lookup&& lookup, double t0, double t1, double mu_bar,
 template <int N, class Lookup>
 Spectrum<N> residual_ratio_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>& mu_c,
                                     double mu_bar_r, Rng& rng, TrackingCounters& counters,
-                                    const Spectrum<N>& T_in = Spectrum<N>(1.0)) {
+                                    const Spectrum<N>& T_in = Spectrum<N>(1.0),
+                                    const Spectrum<N>* weight = nullptr) {
   Spectrum<N> T = T_in * exp(mu_c * (t0 - t1));
   track_tentative_collisions(lookup, t0, t1, mu_bar_r, rng, counters,
                              [&](double, const MediumSample<N>& m) {
@@ -76,7 +91,7 @@ Spectrum<N> residual_ratio_tracking(Lookup&& lookup, double t0, double t1, const
                                const double needed = largest_carried(gap, T);
                                T *= Spectrum<N>(1.0) - (m.mu_t() - mu_c) / mu_bar_r;
                                raise_majorant(mu_bar_r, needed, counters);
-                               return !T.is_black() && transmittance_roulette(T, rng);
+                               return !T.is_black() && transmittance_roulette(T, rng, weight);
                              });
   return T;
 }
