@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cctype>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -625,6 +626,25 @@ CLI::Validator integer_in(long long lo, long long hi = std::numeric_limits<int>:
       fmt::format("INT >= {}", lo));
 }
 
+// A number of seconds > 0, with the check said in words, as integer_in does.
+CLI::Validator positive_seconds() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        double x = 0;
+        size_t used = 0;
+        try {
+          x = std::stod(value, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used == 0 || used != value.size())
+          return fmt::format("must be a number, not \"{}\"", value);
+        if (!(x > 0) || !std::isfinite(x)) return fmt::format("must be > 0, not {}", value);
+        return {};
+      },
+      "SECONDS > 0");
+}
+
 int run_command(int argc, char** argv, const Cluster& cluster) {
   CLI::App app{"nimbus: renders functionally specified objects and participating media"};
   app.set_version_flag("--version", std::string("nimbus ") + NIMBUS_VERSION);
@@ -656,7 +676,7 @@ int run_command(int argc, char** argv, const Cluster& cluster) {
   render
       ->add_option("--checkpoint-interval", args.checkpoint_interval,
                    "Seconds between checkpoints (default 60)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_seconds());
   render->add_option("--resume", args.resume,
                      "Continue the render of this checkpoint up to --spp (default: the spp it "
                      "was started with); later checkpoints go to the same file unless "

@@ -166,6 +166,11 @@ TEST_F(Checkpoints, ACheckpointOfOtherSettingsIsRefused) {
   EXPECT_EQ(missing.err, "nimbus: --resume: none.nck: cannot open the checkpoint\n");
   const Ran interval = nimbus("--checkpoint-interval 5 -o b.exr");
   EXPECT_EQ(interval.code, 2);
+  EXPECT_EQ(interval.err, "nimbus: --checkpoint-interval needs --checkpoint or --resume\n");
+  const Ran zero = nimbus("--checkpoint ck.nck --checkpoint-interval 0 -o b.exr");
+  EXPECT_EQ(zero.code, 2);
+  EXPECT_NE(zero.err.find("--checkpoint-interval: must be > 0, not 0"), std::string::npos)
+      << zero.err;
   EXPECT_FALSE(fs::exists(dir_ / "b.exr"));
   // Threads, outputs and spp change no pixel's samples: accepted.
   EXPECT_EQ(nimbus("--resume ck.nck --spp 3 --threads 1 -o c.png").code, 0);

@@ -171,5 +171,23 @@ TEST(Fingerprint, NamesTheFirstSettingThatDiffers) {
             "scene.integrator.tracking: absent in the checkpoint, \"delta\" now");
 }
 
+// A resumed render must read the same grids: the fingerprint holds their files' hashes.
+TEST(Fingerprint, HoldsTheFilesTheMediaRead) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("nimbus_fp_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "scene.json") << R"({"integrator": {"spp": 4, "seed": 2},
+    "media": {"m": {"density": {"type": "vdb", "file": "g.vdb"}}}})";
+  std::ofstream(dir / "g.vdb") << "grid one";
+  const std::string scene = (dir / "scene.json").string();
+  const nlohmann::json before = render_fingerprint(scene, {"integrator.spp=8"});
+  EXPECT_EQ(fingerprint_difference(before, render_fingerprint(scene, {"integrator.spp=24"})), "");
+  std::ofstream(dir / "g.vdb") << "grid two";
+  const std::string d = fingerprint_difference(before, render_fingerprint(scene, {}));
+  EXPECT_EQ(d.rfind("files./media/m/density/file: ", 0), 0u) << d;
+  EXPECT_NE(fingerprint_difference(before, render_fingerprint(scene, {"integrator.seed=3"})), "");
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace nimbus

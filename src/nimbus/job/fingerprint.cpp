@@ -79,17 +79,20 @@ nlohmann::json render_fingerprint(const std::string& scene_path,
   for (const std::string& o : overrides) apply_override(scene, o);
   if (scene.contains("integrator") && scene["integrator"].is_object())
     scene["integrator"].erase("spp");
+  // The files a medium reads (a "vdb" density's grid, an emission grid): every "file" string of
+  // an object inside a medium, relative to the scene file's folder.
   nlohmann::json files = nlohmann::json::object();
   if (scene.contains("media") && scene["media"].is_object())
-    for (const auto& [name, medium] : scene["media"].items())
-      if (medium.contains("density") && medium["density"].is_object() &&
-          medium["density"].value("type", "") == "vdb" && medium["density"].contains("file") &&
-          medium["density"]["file"].is_string()) {
-        const std::filesystem::path file = medium["density"]["file"].get<std::string>();
-        const std::filesystem::path full =
-            file.is_absolute() ? file : std::filesystem::path(scene_path).parent_path() / file;
-        files["/media/" + name + "/density/file"] = fmt::format("{:016x}", hash_file(full));
-      }
+    for (const auto& [name, medium] : scene["media"].items()) {
+      if (!medium.is_object()) continue;
+      for (const auto& [key, part] : medium.items())
+        if (part.is_object() && part.contains("file") && part["file"].is_string()) {
+          const std::filesystem::path file = part["file"].get<std::string>();
+          const std::filesystem::path full =
+              file.is_absolute() ? file : std::filesystem::path(scene_path).parent_path() / file;
+          files["/media/" + name + "/" + key + "/file"] = fmt::format("{:016x}", hash_file(full));
+        }
+    }
   return {{"nimbus", NIMBUS_VERSION}, {"scene", scene}, {"files", files}};
 }
 

@@ -1,8 +1,8 @@
 #pragma once
 // What a checkpoint must match to be continued (job/checkpoint.h): everything that changes a
 // pixel's samples. The scene document after the --set overrides (--seed included), without
-// integrator.spp, which only says how many samples to take; the content of the files it reads
-// (VDB grids); the nimbus version. Not the threads, the processes or the outputs, which change
+// integrator.spp, which only says how many samples to take; the content of the files its media
+// read (VDB grids); the nimbus version. Not the threads, the processes or the outputs, which change
 // no pixel.
 
 #include <cstdint>
