@@ -33,6 +33,7 @@ struct VdbParams {
   std::string file;                   // a .vdb or .nvdb file (told apart by their magic numbers)
   std::string grid = "density";       // the grid's name in the file
   Mat4 transform = Mat4::identity();  // applied after the grid's index-to-world transform
+  std::string quantity = "density";   // what the values are, in messages
 };
 
 // Why a file cannot serve as a density. `key` names the parameter at fault, "file" or "grid";

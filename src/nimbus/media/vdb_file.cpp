@@ -76,7 +76,8 @@ Format sniff(const std::string& file) {
 // (negative ones as 0), inactive voxels and tiles 0, leaves without active voxels dropped, so that
 // every node left holds active values and its extrema are those range() needs.
 template <class GridT>
-openvdb::FloatGrid::Ptr cleaned(const GridT& in, const std::string& file, const std::string& name) {
+openvdb::FloatGrid::Ptr cleaned(const GridT& in, const std::string& file, const std::string& name,
+                                const std::string& quantity) {
   openvdb::FloatGrid::Ptr out = openvdb::FloatGrid::create(0.0f);
   out->setTransform(in.transform().copy());
   openvdb::FloatTree& tree = out->tree();
@@ -84,8 +85,8 @@ openvdb::FloatGrid::Ptr cleaned(const GridT& in, const std::string& file, const 
     const float f = static_cast<float>(std::max(v, 0.0));
     if (!std::isfinite(v) || !std::isfinite(f))
       fail_grid(file, name,
-                fmt::format("holds the value {} at voxel ({}, {}, {}); a density must be finite", v,
-                            at.x(), at.y(), at.z()));
+                fmt::format("holds the value {} at voxel ({}, {}, {}); a {} must be finite", v,
+                            at.x(), at.y(), at.z(), quantity));
     return f;
   };
   for (auto leaf = in.tree().cbeginLeaf(); leaf; ++leaf) {
@@ -103,15 +104,17 @@ openvdb::FloatGrid::Ptr cleaned(const GridT& in, const std::string& file, const 
 
 // The checks that need only the grid's metadata: a float or double fog volume with a linear
 // transform.
-void check_grid(const openvdb::GridBase& g, const std::string& file, const std::string& name) {
+void check_grid(const openvdb::GridBase& g, const std::string& file, const std::string& name,
+                const std::string& quantity) {
   if (!g.isType<openvdb::FloatGrid>() && !g.isType<openvdb::DoubleGrid>())
-    fail_grid(
-        file, name,
-        fmt::format("holds {} values; a density grid holds float or double values", g.valueType()));
+    fail_grid(file, name,
+              fmt::format("holds {} values; a {} grid holds float or double values", g.valueType(),
+                          quantity));
   if (g.getGridClass() == openvdb::GRID_LEVEL_SET)
     fail_grid(file, name,
-              "is a level set (signed distances), not a density; convert it to a fog volume "
-              "first (OpenVDB's tools::sdfToFogVolume)");
+              fmt::format("is a level set (signed distances), not a {}; convert it to a fog "
+                          "volume first (OpenVDB's tools::sdfToFogVolume)",
+                          quantity));
   if (!g.transform().isLinear())
     fail_grid(file, name,
               fmt::format("has a non-linear transform ({}); only linear (affine) grid "
@@ -119,7 +122,8 @@ void check_grid(const openvdb::GridBase& g, const std::string& file, const std::
                           g.transform().mapType()));
 }
 
-openvdb::FloatGrid::Ptr read_openvdb(const std::string& file, const std::string& name) {
+openvdb::FloatGrid::Ptr read_openvdb(const std::string& file, const std::string& name,
+                                     const std::string& quantity) {
   openvdb::io::File f(file);
   try {
     f.open(/*delayLoad=*/false);
@@ -129,12 +133,12 @@ openvdb::FloatGrid::Ptr read_openvdb(const std::string& file, const std::string&
   std::vector<std::string> names;
   for (auto it = f.beginName(); it != f.endName(); ++it) names.push_back(*it);
   if (!f.hasGrid(name)) fail_grid(file, name, fmt::format("is not in the file ({})", holds(names)));
-  check_grid(*f.readGridMetadata(name), file, name);
+  check_grid(*f.readGridMetadata(name), file, name, quantity);
   const openvdb::GridBase::Ptr grid = f.readGrid(name);
   f.close();
   if (const auto g = openvdb::gridConstPtrCast<openvdb::FloatGrid>(grid))
-    return cleaned(*g, file, name);
-  return cleaned(*openvdb::gridConstPtrCast<openvdb::DoubleGrid>(grid), file, name);
+    return cleaned(*g, file, name, quantity);
+  return cleaned(*openvdb::gridConstPtrCast<openvdb::DoubleGrid>(grid), file, name, quantity);
 }
 
 // Whether every node of a NanoVDB grid lies inside its buffer, 32-byte aligned: a corrupted file
@@ -168,7 +172,8 @@ bool nano_nodes_inside(const nanovdb::NanoGrid<T>& grid, std::uint64_t size) {
 
 template <class T>
 openvdb::FloatGrid::Ptr nano_to_cleaned(const nanovdb::GridHandle<>& handle,
-                                        const std::string& file, const std::string& name) {
+                                        const std::string& file, const std::string& name,
+                                        const std::string& quantity) {
   const nanovdb::NanoGrid<T>* grid = handle.grid<T>();
   if (!grid) fail_file(file, fmt::format("grid \"{}\" could not be read (corrupted file)", name));
   if (!nano_nodes_inside(*grid, handle.size()))
@@ -177,11 +182,53 @@ openvdb::FloatGrid::Ptr nano_to_cleaned(const nanovdb::GridHandle<>& handle,
       !problem.empty())
     fail_file(file, fmt::format("corrupted NanoVDB file ({})", problem));
   const auto open = nanovdb::nanoToOpenVDB(*grid);
-  check_grid(*open, file, name);
-  return cleaned(*open, file, name);
+  check_grid(*open, file, name, quantity);
+  return cleaned(*open, file, name, quantity);
 }
 
-openvdb::FloatGrid::Ptr read_nanovdb(const std::string& file, const std::string& name) {
+// NanoVDB's readGridMetaData trusts each grid's name: it allocates the name's stated length and
+// reads it with strlen, so a damaged header makes it allocate gigabytes or read past its buffer
+// (found by fuzz/vdb_fuzzer.cpp). The segments are walked here first, as that function walks
+// them, with every length checked against the file; a bad magic number is left to the library.
+void check_nanovdb_headers(const std::string& file) {
+  std::error_code ec;
+  const std::uint64_t size = fs::file_size(file, ec);
+  if (ec) fail_file(file, fmt::format("cannot read file ({})", ec.message()));
+  std::ifstream in(file, std::ios::binary);
+  std::uint64_t at = 0;
+  while (size - at >= sizeof(nanovdb::io::Header)) {
+    nanovdb::io::Header header;
+    in.read(reinterpret_cast<char*>(&header), sizeof header);
+    at += sizeof header;
+    if (!in || header.magic != NANOVDB_MAGIC_NUMBER) return;
+    std::uint64_t data = 0;
+    for (int g = 0; g < header.gridCount; ++g) {
+      nanovdb::io::MetaData meta;
+      if (size - at < sizeof meta)
+        fail_file(file, "corrupted NanoVDB file (a grid's header is cut short)");
+      in.read(reinterpret_cast<char*>(&meta), sizeof meta);
+      at += sizeof meta;
+      if (meta.nameSize == 0 || meta.nameSize > size - at)
+        fail_file(file, "corrupted NanoVDB file (a grid's name runs past the end of the file)");
+      std::string grid_name(meta.nameSize, '\0');
+      in.read(grid_name.data(), meta.nameSize);
+      if (grid_name.find('\0') == std::string::npos)
+        fail_file(file, "corrupted NanoVDB file (a grid's name is not terminated)");
+      at += meta.nameSize;
+      if (meta.fileSize > size)
+        fail_file(file, "corrupted NanoVDB file (a grid is larger than the file)");
+      data += meta.fileSize;
+    }
+    if (data > size - at)
+      fail_file(file, "corrupted NanoVDB file (a grid is larger than the file)");
+    at += data;
+    in.seekg(static_cast<std::streamoff>(at));
+  }
+}
+
+openvdb::FloatGrid::Ptr read_nanovdb(const std::string& file, const std::string& name,
+                                     const std::string& quantity) {
+  check_nanovdb_headers(file);
   std::vector<nanovdb::io::GridMetaData> grids;
   try {
     grids = nanovdb::io::readGridMetaData(file);
@@ -198,12 +245,13 @@ openvdb::FloatGrid::Ptr read_nanovdb(const std::string& file, const std::string&
   const nanovdb::GridType type = meta->gridType;
   if (type != nanovdb::GridType::Float && type != nanovdb::GridType::Double)
     fail_grid(file, name,
-              fmt::format("holds {} values; a density grid holds float or double values",
-                          nanovdb::toStr(type)));
+              fmt::format("holds {} values; a {} grid holds float or double values",
+                          nanovdb::toStr(type), quantity));
   if (meta->gridClass == nanovdb::GridClass::LevelSet)
     fail_grid(file, name,
-              "is a level set (signed distances), not a density; convert it to a fog volume "
-              "first");
+              fmt::format("is a level set (signed distances), not a {}; convert it to a fog "
+                          "volume first",
+                          quantity));
   if (meta->codec != nanovdb::io::Codec::NONE)
     fail_file(file, fmt::format("grid \"{}\" is compressed ({}); nimbus reads uncompressed .nvdb "
                                 "files (nanovdb_convert without -z or -b)",
@@ -217,8 +265,8 @@ openvdb::FloatGrid::Ptr read_nanovdb(const std::string& file, const std::string&
   } catch (const std::exception& e) {
     fail_file(file, fmt::format("corrupted NanoVDB file ({})", e.what()));
   }
-  return type == nanovdb::GridType::Float ? nano_to_cleaned<float>(handle, file, name)
-                                          : nano_to_cleaned<double>(handle, file, name);
+  return type == nanovdb::GridType::Float ? nano_to_cleaned<float>(handle, file, name, quantity)
+                                          : nano_to_cleaned<double>(handle, file, name, quantity);
 }
 
 // The affine map from index space to the grid's world space, from the images of the origin and
@@ -238,12 +286,14 @@ Mat4 world_from_index(const openvdb::math::Transform& t) {
 
 }  // namespace
 
-VdbFileGrid read_vdb_file(const std::string& file, const std::string& name) {
+VdbFileGrid read_vdb_file(const std::string& file, const std::string& name,
+                          const std::string& quantity) {
   openvdb::initialize();  // registers the grid types; cheap after the first call
   const Format format = sniff(file);
   openvdb::FloatGrid::Ptr grid;
   try {
-    grid = format == Format::OpenVdb ? read_openvdb(file, name) : read_nanovdb(file, name);
+    grid = format == Format::OpenVdb ? read_openvdb(file, name, quantity)
+                                     : read_nanovdb(file, name, quantity);
   } catch (const VdbError&) {
     throw;
   } catch (const std::exception& e) {

@@ -19,7 +19,9 @@ struct VdbFileGrid {
   std::uint64_t active_voxels = 0;
 };
 
-// Throws VdbError (vdb_density.h) for every way the file or grid can be unusable.
-VdbFileGrid read_vdb_file(const std::string& file, const std::string& grid);
+// Throws VdbError (vdb_density.h) for every way the file or grid can be unusable; `quantity`
+// ("density", "temperature") is what the messages call the grid's values.
+VdbFileGrid read_vdb_file(const std::string& file, const std::string& grid,
+                          const std::string& quantity);
 
 }  // namespace nimbus
