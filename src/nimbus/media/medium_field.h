@@ -75,7 +75,10 @@ MediumPoint<N> medium_at(const S& scene, const std::vector<MediumCoefficients<N>
     const Spectrum<N> mu_a = c.sigma_a * density, mu_s = c.sigma_s * density;
     m.mu_a += mu_a;
     m.mu_s += mu_s;
-    m.mu_a_Le += mu_a * c.emission;
+    if (c.emission_grid)
+      m.mu_a_Le += mu_a * temperature_emission_at<N>(*c.emission_grid, x, c.spectral, c.lambda);
+    else
+      m.mu_a_Le += mu_a * c.emission;
     m.g[m.media] = scene.media[medium].g;
     m.mu_s_i[m.media] = mu_s;
     ++m.media;

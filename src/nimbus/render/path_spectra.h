@@ -41,8 +41,15 @@ void prepare_path_spectra(PathSpectra<N>& ps, const Scene& scene, double u) {
   ps.media.resize(scene.media.size());
   for (size_t m = 0; m < scene.media.size(); ++m) {
     const Medium& med = scene.media[m];
-    ps.media[m] = {evaluate(med.sigma_a, ps.ch), evaluate(med.sigma_s, ps.ch),
-                   evaluate(med.emission, ps.ch)};
+    MediumCoefficients<N>& c = ps.media[m];
+    c.sigma_a = evaluate(med.sigma_a, ps.ch);
+    c.sigma_s = evaluate(med.sigma_s, ps.ch);
+    c.emission = evaluate(med.emission, ps.ch);
+    c.emission_grid = med.emission_grid.get();
+    if (c.emission_grid) {
+      c.spectral = ps.ch.spectral;
+      c.lambda = ps.ch.wl.lambda;
+    }
   }
   ps.lights.resize(scene.lights.size());
   for (size_t l = 0; l < scene.lights.size(); ++l)

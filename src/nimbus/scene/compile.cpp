@@ -73,6 +73,7 @@ Medium compile_medium(const MediumDesc& d) {
   m.sigma_a = d.sigma_a;
   m.sigma_s = d.sigma_s;
   m.emission = d.emission;
+  m.emission_grid = d.emission_grid;
   m.g = d.phase.type == PhaseDesc::Type::HenyeyGreenstein ? d.phase.g : 0.0;
   m.density = d.density;
   m.scale = d.density_scale;

@@ -20,6 +20,7 @@
 #include "nimbus/render/setting_names.h"
 #include "nimbus/render/wavelength_counts.h"
 #include "nimbus/scene/density_types.h"
+#include "nimbus/scene/emission_grid.h"
 
 namespace nimbus {
 namespace {
@@ -283,8 +284,12 @@ class Loader {
       m.sigma_a = read_colour(*x, SpectralRole::Unbounded, at_least(0));
     if (auto x = o.optional("sigma_s"))
       m.sigma_s = read_colour(*x, SpectralRole::Unbounded, at_least(0));
-    if (auto x = o.optional("emission"))
-      m.emission = read_colour(*x, SpectralRole::Illuminant, at_least(0));
+    if (auto x = o.optional("emission")) {
+      if (is_emission_grid(*x))
+        m.emission_grid = read_emission_grid(*x);
+      else
+        m.emission = read_colour(*x, SpectralRole::Illuminant, at_least(0));
+    }
     if (auto x = o.optional("phase")) {
       JsonObject p(*x);
       std::string type = "isotropic";

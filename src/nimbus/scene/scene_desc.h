@@ -4,6 +4,7 @@
 // trusts these values; docs/scene-format.md documents every field.
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "nimbus/math/vec3.h"
 #include "nimbus/media/constant_density.h"
 #include "nimbus/media/density.h"
+#include "nimbus/media/temperature_emission.h"
 #include "nimbus/render/scene.h"
 #include "nimbus/spectral/spectral_param.h"
 
@@ -62,6 +64,8 @@ struct PhaseDesc {
 struct MediumDesc {
   std::string name;
   SpectralParam sigma_a, sigma_s, emission;
+  // Set: the emission is a temperature grid's (media/temperature_emission.h).
+  std::shared_ptr<const TemperatureEmission> emission_grid;
   PhaseDesc phase;
   DensityPtr density = make_constant_density();  // made by its type's reader (density_types.h)
   double density_scale = 1;

@@ -9,6 +9,7 @@
 
 #include "nimbus/spectral/cie.h"
 #include "nimbus/spectral/color.h"
+#include "nimbus/spectral/planck.h"
 #include "nimbus/spectral/spectral_tables.h"
 
 namespace nimbus {
@@ -22,11 +23,6 @@ double sigmoid(double x) {
   if (std::abs(x) > 1e150) return x > 0 ? 1 : 0;
   return 0.5 + 0.5 * x / std::sqrt(1 + x * x);
 }
-
-// hc/k in nm·K (exact SI constants), and the root of x = 5 (1 − e^{−x}), which puts Wien's peak
-// of Planck's law at λ = hc / (x k T).
-constexpr double kPlanckC2 = 6.62607015e-34 * 299792458.0 / 1.380649e-23 * 1e9;
-constexpr double kWienX = 4.965114231744276303;
 
 double wien_peak_nm(double kelvin) {
   return kPlanckC2 / (kWienX * kelvin);
