@@ -1,32 +1,50 @@
 #!/usr/bin/env bash
-# The fuzzer (docs/testing.md, "Fuzzing"): builds the libFuzzer scene target in build-sanitize/
-# (clang, ASan, UBSan; tools/sanitize.sh shares that build) and fuzzes from the committed corpus
-# fuzz/corpus with the scene-format dictionary fuzz/scene.dict.
-#   tools/fuzz.sh [SECONDS] [JOBS]   fuzz for SECONDS (default 60) with JOBS processes (default
-#                                    1); new inputs go to build-sanitize/fuzz-corpus
-#   tools/fuzz.sh --runs N           N inputs from a fixed seed, new inputs discarded: the
-#                                    deterministic check that tools/sanitize.sh runs
-# A finding is written to build-sanitize/fuzz-findings/ and fails the script.
+# The fuzzers (docs/testing.md, "Fuzzing"): builds the libFuzzer targets in build-sanitize/
+# (clang, ASan, UBSan; tools/sanitize.sh shares that build; NIMBUS_FUZZ_BUILD=DIR builds in DIR
+# instead) and fuzzes from a committed corpus: the scene target from fuzz/corpus with the
+# scene-format dictionary fuzz/scene.dict, or with --vdb the VDB reader's target from
+# fuzz/vdb_corpus.
+#   tools/fuzz.sh [--vdb] [SECONDS] [JOBS]   fuzz for SECONDS (default 60) with JOBS processes
+#                                            (default 1); new inputs go to BUILD/fuzz-corpus (or
+#                                            BUILD/vdb-fuzz-corpus)
+#   tools/fuzz.sh [--vdb] --runs N           N inputs from a fixed seed, new inputs discarded:
+#                                            the deterministic check that tools/sanitize.sh runs
+# A finding is written to BUILD/fuzz-findings/ and fails the script.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-CXX=clang++ cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNIMBUS_SANITIZE=ON \
+build=${NIMBUS_FUZZ_BUILD:-build-sanitize}
+target=nimbus_fuzz
+corpus=fuzz/corpus
+kept=fuzz-corpus
+# -max_len: the largest shipped scene is 7.3 kB.
+options=(-dict=fuzz/scene.dict -max_len=8192)
+if [ "${1:-}" = "--vdb" ]; then
+  shift
+  target=nimbus_vdb_fuzz
+  corpus=fuzz/vdb_corpus
+  kept=vdb-fuzz-corpus
+  # The corpus's files are at most 16 kB. No leak reports: OpenVDB leaks the nodes of a tree
+  # whose reading threw (docs/testing.md).
+  options=(-max_len=16384 -detect_leaks=0)
+fi
+CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNIMBUS_SANITIZE=ON \
   -DNIMBUS_BUILD_FUZZER=ON -DNIMBUS_BUILD_BENCH=OFF >/dev/null
-cmake --build build-sanitize -j"$(nproc)" --target nimbus_fuzz
-mkdir -p build-sanitize/fuzz-findings
-# -timeout: a tiny render that takes 20 s is a hang worth reporting; -rss_limit_mb: the same for
-# memory. -max_len: the largest shipped scene is 7.3 kB.
-options=(-dict=fuzz/scene.dict -timeout=20 -rss_limit_mb=2048 -max_len=8192
-  -artifact_prefix=build-sanitize/fuzz-findings/ -print_final_stats=1)
+cmake --build "$build" -j"$(nproc)" --target "$target"
+mkdir -p "$build/fuzz-findings"
+# -timeout: an input that takes 20 s is a hang worth reporting; -rss_limit_mb: the same for
+# memory.
+options+=(-timeout=20 -rss_limit_mb=2048 -artifact_prefix="$build/fuzz-findings/"
+  -print_final_stats=1)
 if [ "${1:-}" = "--runs" ]; then
   scratch=$(mktemp -d)
   trap 'rm -rf "$scratch"' EXIT
-  ./build-sanitize/nimbus_fuzz "${options[@]}" -seed=1 -runs="$2" "$scratch" fuzz/corpus
+  "./$build/$target" "${options[@]}" -seed=1 -runs="$2" "$scratch" "$corpus"
   exit
 fi
 seconds=${1:-60}
 jobs=${2:-1}
 parallel=()
 if [ "$jobs" -gt 1 ]; then parallel=(-jobs="$jobs" -workers="$jobs"); fi
-mkdir -p build-sanitize/fuzz-corpus
-./build-sanitize/nimbus_fuzz "${options[@]}" -max_total_time="$seconds" "${parallel[@]}" \
-  build-sanitize/fuzz-corpus fuzz/corpus
+mkdir -p "$build/$kept"
+"./$build/$target" "${options[@]}" -max_total_time="$seconds" "${parallel[@]}" \
+  "$build/$kept" "$corpus"
