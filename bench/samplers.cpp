@@ -51,7 +51,7 @@ double sampler_ns_per_sample(RenderSettings::Sampler kind, int bounces) {
   settings.width = settings.height = 256;
   settings.spp = 16;
   settings.sampler = kind;
-  const ZSobol zsobol(settings.width, settings.height, settings.spp, settings.seed);
+  const ZSobol zsobol(settings.width, settings.height, settings.seed);
   double sink = 0;
   const auto start = std::chrono::steady_clock::now();
   for (int y = 0; y < 64; ++y)

@@ -106,8 +106,9 @@ TEST_F(Mpi, ASceneErrorIsOneLineFromRankZeroAndExitTwo) {
   EXPECT_FALSE(fs::exists(dir_ / "bad.exr"));
 }
 
-// A checkpoint written by two ranks is continued by three, to more samples (the independent
-// sampler: docs/cli.md), and gives the pixels of one process rendering them at once.
+// A checkpoint written by two ranks is continued by three, to more samples, and gives the pixels
+// of one process rendering them at once (either sampler; here the independent one, while the
+// checkpoint tests check the default).
 TEST_F(Mpi, CheckpointsCarryAcrossRankCounts) {
   const std::string sampler = "--set integrator.sampler=independent ";
   ASSERT_EQ(mpirun(2, sampler + "--spp 3 --checkpoint ck.nck -o a.exr").code, 0);

@@ -3,16 +3,20 @@
 // blue-noise diffusion of Monte Carlo sampling error via hierarchical ordering of pixels").
 //
 // One (0,2)-sequence in base 2, Sobol's first two dimensions, serves every dimension of a path.
-// Sample s of pixel (x, y) takes the point at index morton(x, y) · 2^K + s, K = ⌈log2 spp⌉, so a
-// pixel's samples are an aligned block of the sequence (a (0,K,2)-net: stratified in 2D and in
-// each 1D projection) and so are a 2×2 quad's, a 4×4 block's, ...: neighbouring pixels' errors
-// cancel (blue noise). Each dimension d sees that index shuffled (shuffle_index): the pixel's
-// base-4 Morton digits each by one of the 24 permutations chosen by a hash of (d, the digits above
-// it), the sample bits by a nested scramble; blocks stay blocks, while different dimensions pair
-// their samples differently (decorrelated). Then the point gets an Owen scramble of its own.
+// Sample s of pixel (x, y) takes the point at index morton(x, y) · 2^K + s with K =
+// kZSobolSampleBits, so a pixel's samples are an aligned block of the sequence and every prefix of
+// 2^m of them is a (0,m,2)-net: stratified in 2D and in each 1D projection. Each dimension d sees
+// that index shuffled (shuffle_index): the pixel's base-4 Morton digits each by one of the 24
+// permutations chosen by a hash of (d, the digits above it), the sample bits by a nested
+// scramble; blocks stay blocks, while different dimensions pair their samples differently
+// (decorrelated). Then the point gets an Owen scramble of its own.
 //
-// A sample's numbers depend on (seed, the film's size, spp, pixel, sample index, dimension) and
-// on nothing rendered before. Samples past 2^K (renders that extend a pixel beyond spp) start a
+// A sample's numbers depend on (seed, the film's size, pixel, sample index, dimension) and on
+// nothing else: not on spp, so a render extended to more samples (a resumed checkpoint, issue 15)
+// is the render made at that spp in one go, bit for bit. That is why K is fixed rather than
+// ⌈log2 spp⌉ as in Ahmed & Wonka (2020), whose pixel blocks of exactly spp samples make a 2×2
+// quad's samples a net too and so spread the error as blue noise across pixels: each pixel's own
+// stratification, and with it its variance, is the same either way. Samples past 2^K start a
 // fresh randomization per block of 2^K, so they never repeat a point.
 
 #include <algorithm>
@@ -162,48 +166,49 @@ constexpr uint64_t shuffle_index(uint64_t index, int pixel_bits, int sample_bits
   return (out << sample_bits) | (zsobol_detail::reverse_bits(scrambled) >> (64 - sample_bits));
 }
 
+// The sample bits of the index: a pixel's block of 2^16 samples (more start new blocks).
+inline constexpr int kZSobolSampleBits = 16;
+
 class ZSobol {
  public:
   // One pixel sample's place in the sequence.
   struct Key {
-    uint64_t index;  // morton(x, y) · 2^K + (s mod 2^K)
+    uint64_t index;  // morton(x, y) · 2^K + (s mod 2^K), K = kZSobolSampleBits
     uint64_t seed;   // the render's seed with the block of 2^K samples that s is in
   };
 
-  // For a film of width × height pixels at spp samples each; std::invalid_argument if the
-  // index would need more than 62 bits.
-  ZSobol(int width, int height, int spp, uint64_t seed) : seed_(seed) {
-    if (width < 1 || height < 1 || spp < 1)
-      throw std::invalid_argument("zsobol: the film and spp must be at least 1");
+  // For a film of width × height pixels; std::invalid_argument if the index would need more
+  // than 62 bits (a side beyond 2^23 pixels).
+  ZSobol(int width, int height, uint64_t seed) : seed_(seed) {
+    if (width < 1 || height < 1)
+      throw std::invalid_argument("zsobol: the film must be at least 1 pixel");
     const int log2_res = std::bit_width(uint32_t(std::max(width, height) - 1));
-    log2_spp_ = std::bit_width(uint32_t(spp - 1));
     pixel_bits_ = 2 * log2_res;
-    if (pixel_bits_ + log2_spp_ > 62)
-      throw std::invalid_argument("zsobol: film × spp beyond 2^62 samples");
+    if (pixel_bits_ + kZSobolSampleBits > 62)
+      throw std::invalid_argument("zsobol: film beyond 2^46 pixels");
   }
 
   Key key(int x, int y, uint64_t sample) const {
-    const uint64_t mask = (uint64_t(1) << log2_spp_) - 1;
-    const uint64_t block = sample >> log2_spp_;
-    return {(zsobol_detail::morton(uint32_t(x), uint32_t(y)) << log2_spp_) | (sample & mask),
-            splitmix64(seed_ ^ splitmix64(block))};
+    const uint64_t mask = (uint64_t(1) << kZSobolSampleBits) - 1;
+    const uint64_t block = sample >> kZSobolSampleBits;
+    return {
+        (zsobol_detail::morton(uint32_t(x), uint32_t(y)) << kZSobolSampleBits) | (sample & mask),
+        splitmix64(seed_ ^ splitmix64(block))};
   }
 
   // Dimension dim: one number, or two (a 2D point of the sequence).
   double get1d(const Key& k, uint32_t dim) const {
     const uint64_t h = dim_hash(k, dim);
-    const uint64_t i = shuffle_index(k.index, pixel_bits_, log2_spp_, h);
+    const uint64_t i = shuffle_index(k.index, pixel_bits_, kZSobolSampleBits, h);
     return reversed_to_unit(owen_scramble_reversed(sobol0_reversed(i), h ^ 0x51ed27062f3a8b4dull));
   }
   std::array<double, 2> get2d(const Key& k, uint32_t dim) const {
     const uint64_t h = dim_hash(k, dim);
-    const uint64_t i = shuffle_index(k.index, pixel_bits_, log2_spp_, h);
+    const uint64_t i = shuffle_index(k.index, pixel_bits_, kZSobolSampleBits, h);
     return {
         reversed_to_unit(owen_scramble_reversed(sobol0_reversed(i), h ^ 0x51ed27062f3a8b4dull)),
         reversed_to_unit(owen_scramble_reversed(sobol1_reversed(i), h ^ 0xa24baed4963ee407ull))};
   }
-
-  int log2_spp() const { return log2_spp_; }
 
  private:
   static uint64_t dim_hash(const Key& k, uint32_t dim) {
@@ -211,7 +216,6 @@ class ZSobol {
   }
 
   uint64_t seed_;
-  int log2_spp_ = 0;
   int pixel_bits_ = 0;
 };
 

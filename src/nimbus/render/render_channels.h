@@ -36,7 +36,7 @@ RenderStats render_channels(const Scene& scene, Film& film, const RenderRange& r
   std::atomic<bool> cancelled{false};
   std::mutex progress_mutex;
   const auto start = std::chrono::steady_clock::now();
-  const ZSobol zsobol(W, scene.settings.height, scene.settings.spp, scene.settings.seed);
+  const ZSobol zsobol(W, scene.settings.height, scene.settings.seed);
 
   constexpr int kTile = 16;
   tbb::parallel_for(
