@@ -58,10 +58,15 @@ class Mpi : public ::testing::Test {
     return run_in(dir_, std::string("'") + NIMBUS_BINARY + "' render scene.json -q " + args);
   }
   // OpenMPI refuses root unless told (CI runs as root); -q drops mpirun's own report of a rank's
-  // non-zero exit, so that stderr holds what nimbus printed.
+  // non-zero exit, so that stderr holds what nimbus printed. OpenMPI's dynamically loaded
+  // components leak at exit (measured: 121 kB in 3 347 allocations from unknown modules), which
+  // LeakSanitizer turns into a failing rank in the sanitized build: leak checks are off for the
+  // ranks (every other test keeps them).
   Ran mpirun(int ranks, const std::string& args) {
 #ifdef NIMBUS_MPIEXEC
-    return run_in(dir_, std::string("OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 '") +
+    return run_in(dir_, std::string("ASAN_OPTIONS=\"${ASAN_OPTIONS:+$ASAN_OPTIONS:}"
+                                    "detect_leaks=0\" OMPI_ALLOW_RUN_AS_ROOT=1 "
+                                    "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 '") +
                             NIMBUS_MPIEXEC + "' -q --oversubscribe -np " + std::to_string(ranks) +
                             " '" + NIMBUS_BINARY + "' render scene.json -q " + args);
 #else
