@@ -186,8 +186,7 @@ Spectrum<N> transmittance(const Scene& scene, const PathSpectra<N>& ps, const Ra
     ++counters.majorant_segments;
     if (residual) {
       // The residual's rate must bound |mu_t − mu_c|; a scaled majorant may fall below mu_c.
-      Spectrum<N> gap;
-      for (int c = 0; c < N; ++c) gap[c] = std::abs(boost * seg.mu_bar[c] - seg.mu_c[c]);
+      const Spectrum<N> gap = abs(seg.mu_bar * boost - seg.mu_c);
       T = residual_ratio_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_c, tracked_max(gap), rng,
                                      counters.tracking, T, &weight);
     } else {

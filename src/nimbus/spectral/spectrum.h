@@ -78,6 +78,13 @@ Spectrum<N> exp(const Spectrum<N>& s) {
   return r;
 }
 
+template <int N>
+Spectrum<N> abs(const Spectrum<N>& s) {
+  Spectrum<N> r;
+  for (int i = 0; i < N; ++i) r[i] = std::abs(s[i]);
+  return r;
+}
+
 using Rgb = Spectrum<3>;
 
 }  // namespace nimbus

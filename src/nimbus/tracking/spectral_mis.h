@@ -40,13 +40,6 @@ struct MisPath {
   Spectrum<N> beta{1.0}, r_u{1.0}, r_l{1.0};
 };
 
-template <int N>
-Spectrum<N> abs_of(const Spectrum<N>& s) {
-  Spectrum<N> r;
-  for (int i = 0; i < N; ++i) r[i] = std::abs(s[i]);
-  return r;
-}
-
 // b per channel: 1 where the channel's majorant bounds mu_t; where it fails (mu_n < 0), the
 // factor mu_maj / (mu_a + mu_s + |mu_n|) that turns P_* = mu_* b / mu_maj into probabilities
 // proportional to |mu_*| that sum to 1, so the channel's technique still samples null events.
@@ -122,7 +115,7 @@ Collision hero_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>
           c = {CollisionEvent::Scatter, t};
           return false;
         }
-        const Spectrum<N> mu_n_abs = abs_of(mu_n);
+        const Spectrum<N> mu_n_abs = abs(mu_n);
         const double pdf = T_maj[h] * mu_n_abs[h] * b[h];
         if (pdf > 0) {
           path.beta *= T_maj * mu_n / pdf;
@@ -160,7 +153,7 @@ bool hero_ratio_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N
         const double pdf = T_maj[h] * maj[h];
         path.beta *= T_maj * mu_n / pdf;
         path.r_l *= T_maj * maj / pdf;
-        path.r_u *= T_maj * abs_of(mu_n) * failing_share(m, mu_n, maj) / pdf;
+        path.r_u *= T_maj * abs(mu_n) * failing_share(m, mu_n, maj) / pdf;
         const Spectrum<N> T = path.beta / (path.r_u + path.r_l).average();
         if (T.max_abs() < 0.05) {  // |T|: a majorant that fails makes it signed
           if (rng.uniform() < 0.75)

@@ -86,9 +86,7 @@ Spectrum<N> residual_ratio_tracking(Lookup&& lookup, double t0, double t1, const
   Spectrum<N> T = T_in * exp(mu_c * (t0 - t1));
   track_tentative_collisions(lookup, t0, t1, mu_bar_r, rng, counters,
                              [&](double, const MediumSample<N>& m) {
-                               Spectrum<N> gap = m.mu_t() - mu_c;
-                               for (int c = 0; c < N; ++c) gap[c] = std::abs(gap[c]);
-                               const double needed = largest_carried(gap, T);
+                               const double needed = largest_carried(abs(m.mu_t() - mu_c), T);
                                T *= Spectrum<N>(1.0) - (m.mu_t() - mu_c) / mu_bar_r;
                                raise_majorant(mu_bar_r, needed, counters);
                                return !T.is_black() && transmittance_roulette(T, rng, weight);
