@@ -220,7 +220,7 @@ class VdbDensity final : public Density {
 }  // namespace
 
 DensityPtr make_vdb_density(const VdbParams& params) {
-  VdbFileGrid grid = read_vdb_file(params.file, params.grid, params.quantity);
+  VdbFileGrid grid = read_vdb_file(params.file, params.grid, params.quantity, params.isolate_reader);
   const Mat4 world_from_index = params.transform * grid.world_from_index;
   const double det = determinant(world_from_index);
   if (!(std::abs(det) > 0) || !std::isfinite(det))

@@ -34,6 +34,10 @@ struct VdbParams {
   std::string grid = "density";       // the grid's name in the file
   Mat4 transform = Mat4::identity();  // applied after the grid's index-to-world transform
   std::string quantity = "density";   // what the values are, in messages
+  // Read a .vdb in a child process under memory and time limits (vdb_file.cpp), so that what
+  // OpenVDB does with a damaged file cannot take the caller's memory or process down. Off only
+  // where the reading itself is under test (the fuzzer needs its coverage in-process).
+  bool isolate_reader = true;
 };
 
 // Why a file cannot serve as a density. `key` names the parameter at fault, "file" or "grid";

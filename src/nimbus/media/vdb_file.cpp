@@ -12,16 +12,20 @@
 #include <nanovdb/util/NanoToOpenVDB.h>
 #include <nanovdb/util/OpenToNanoVDB.h>
 #include <openvdb/io/File.h>
+#include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <vector>
 
+#include "nimbus/media/isolated_call.h"
 #include "nimbus/media/vdb_density.h"
 
 namespace nimbus {
@@ -29,13 +33,27 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The libraries' messages may span lines (NanoVDB's version check does); an error is one line.
+std::string one_line(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    const bool space = std::isspace(static_cast<unsigned char>(c));
+    if (!space)
+      out += c;
+    else if (!out.empty() && out.back() != ' ')
+      out += ' ';
+  }
+  while (!out.empty() && out.back() == ' ') out.pop_back();
+  return out;
+}
+
 [[noreturn]] void fail_file(const std::string& file, const std::string& problem) {
-  throw VdbError("file", fmt::format("{}: {}", file, problem));
+  throw VdbError("file", fmt::format("{}: {}", file, one_line(problem)));
 }
 
 [[noreturn]] void fail_grid(const std::string& file, const std::string& grid,
                             const std::string& problem) {
-  throw VdbError("grid", fmt::format("{}: grid \"{}\" {}", file, grid, problem));
+  throw VdbError("grid", fmt::format("{}: grid \"{}\" {}", file, grid, one_line(problem)));
 }
 
 // "the file holds grids "a", "b"" or "the file holds no grid".
@@ -127,6 +145,8 @@ openvdb::FloatGrid::Ptr read_openvdb(const std::string& file, const std::string&
   openvdb::io::File f(file);
   try {
     f.open(/*delayLoad=*/false);
+  } catch (const std::bad_alloc&) {
+    throw;
   } catch (const std::exception& e) {
     fail_file(file, fmt::format("not a readable OpenVDB file ({})", e.what()));
   }
@@ -139,6 +159,68 @@ openvdb::FloatGrid::Ptr read_openvdb(const std::string& file, const std::string&
   if (const auto g = openvdb::gridConstPtrCast<openvdb::FloatGrid>(grid))
     return cleaned(*g, file, name, quantity);
   return cleaned(*openvdb::gridConstPtrCast<openvdb::DoubleGrid>(grid), file, name, quantity);
+}
+
+// The limits on reading a .vdb in a child: generous for real files (their data rarely expands
+// beyond 10x when decompressed, and the child holds it about four times over), small against
+// the gigabytes a damaged length field asks for.
+IsolationLimits reader_limits(const std::string& file) {
+  std::error_code ec;
+  const double bytes = double(fs::file_size(file, ec));
+  return {(std::uint64_t(1) << 30) + std::uint64_t(128 * bytes), 10 + bytes / 1e6};
+}
+
+// read_openvdb in a child process (isolated_call.h): what OpenVDB does with a damaged file
+// (allocations of gigabytes, crashes, warnings on stderr) stays there. The child sends back the
+// cleaned grid in OpenVDB's stream format, uncompressed, or the VdbError it threw.
+openvdb::FloatGrid::Ptr read_openvdb_isolated(const std::string& file, const std::string& name,
+                                              const std::string& quantity) {
+  const IsolationLimits limits = reader_limits(file);
+  const IsolatedResult r = call_isolated(
+      [&]() -> std::string {
+        try {
+          const openvdb::FloatGrid::Ptr grid = read_openvdb(file, name, quantity);
+          std::ostringstream out(std::ios::binary);
+          openvdb::io::Stream stream(out);
+          stream.setCompression(openvdb::io::COMPRESS_NONE);
+          stream.write(openvdb::GridCPtrVec{grid});
+          return "G" + std::move(out).str();
+        } catch (const VdbError& e) {
+          return fmt::format("E{}\n{}", e.key, e.what());
+        } catch (const std::bad_alloc&) {
+          throw;
+        } catch (const std::exception& e) {
+          return fmt::format("Efile\n{}: corrupted OpenVDB file ({})", file, e.what());
+        }
+      },
+      limits);
+  using Status = IsolatedResult::Status;
+  switch (r.status) {
+    case Status::NotIsolated:
+      return read_openvdb(file, name, quantity);
+    case Status::OutOfMemory:
+      fail_file(file, fmt::format("corrupted OpenVDB file (reading it needed more than {:.1f} GB, "
+                                  "the limit for a file of this size)",
+                                  double(limits.memory_bytes) / 1e9));
+    case Status::TimedOut:
+      fail_file(file, fmt::format("corrupted OpenVDB file (reading it took more than {:.0f} s, "
+                                  "the limit for a file of this size)",
+                                  limits.seconds));
+    case Status::Crashed:
+      fail_file(file, r.signal ? fmt::format("corrupted OpenVDB file (OpenVDB's reader crashed "
+                                             "on it: {})",
+                                             strsignal(r.signal))
+                               : "corrupted OpenVDB file (OpenVDB's reader failed on it)");
+    case Status::Done:
+      break;
+  }
+  if (!r.bytes.empty() && r.bytes[0] == 'E') {
+    const std::size_t eol = r.bytes.find('\n');
+    throw VdbError(r.bytes.substr(1, eol - 1), r.bytes.substr(eol + 1));
+  }
+  std::istringstream in(r.bytes.substr(1), std::ios::binary);
+  openvdb::io::Stream stream(in, /*delayLoad=*/false);
+  return openvdb::gridPtrCast<openvdb::FloatGrid>(stream.getGrids()->at(0));
 }
 
 // Whether every node of a NanoVDB grid lies inside its buffer, 32-byte aligned: a corrupted file
@@ -201,6 +283,11 @@ void check_nanovdb_headers(const std::string& file) {
     in.read(reinterpret_cast<char*>(&header), sizeof header);
     at += sizeof header;
     if (!in || header.magic != NANOVDB_MAGIC_NUMBER) return;
+    if (header.version.getMajor() != NANOVDB_MAJOR_VERSION_NUMBER)
+      fail_file(file, fmt::format("written by NanoVDB {}.{}.{}; this build of nimbus reads files "
+                                  "of NanoVDB {}.x",
+                                  header.version.getMajor(), header.version.getMinor(),
+                                  header.version.getPatch(), NANOVDB_MAJOR_VERSION_NUMBER));
     std::uint64_t data = 0;
     for (int g = 0; g < header.gridCount; ++g) {
       nanovdb::io::MetaData meta;
@@ -287,13 +374,17 @@ Mat4 world_from_index(const openvdb::math::Transform& t) {
 }  // namespace
 
 VdbFileGrid read_vdb_file(const std::string& file, const std::string& name,
-                          const std::string& quantity) {
+                          const std::string& quantity, bool isolate) {
   openvdb::initialize();  // registers the grid types; cheap after the first call
   const Format format = sniff(file);
   openvdb::FloatGrid::Ptr grid;
   try {
-    grid = format == Format::OpenVdb ? read_openvdb(file, name, quantity)
-                                     : read_nanovdb(file, name, quantity);
+    if (format == Format::NanoVdb)
+      grid = read_nanovdb(file, name, quantity);
+    else if (isolate)
+      grid = read_openvdb_isolated(file, name, quantity);
+    else
+      grid = read_openvdb(file, name, quantity);
   } catch (const VdbError&) {
     throw;
   } catch (const std::exception& e) {

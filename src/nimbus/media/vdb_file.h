@@ -20,8 +20,9 @@ struct VdbFileGrid {
 };
 
 // Throws VdbError (vdb_density.h) for every way the file or grid can be unusable; `quantity`
-// ("density", "temperature") is what the messages call the grid's values.
+// ("density", "temperature") is what the messages call the grid's values. `isolate`: read an
+// OpenVDB file in a child process under limits (VdbParams::isolate_reader).
 VdbFileGrid read_vdb_file(const std::string& file, const std::string& grid,
-                          const std::string& quantity);
+                          const std::string& quantity, bool isolate = true);
 
 }  // namespace nimbus
