@@ -1,0 +1,311 @@
+#!/usr/bin/python3
+"""nimbus against pbrt-v4 on the same scenes (issue 13): run by bench/pbrt_side_by_side.sh.
+
+Per scene, every renderer configuration renders SPP samples per pixel on one thread, REPS
+times (seeds 1..REPS), configurations interleaved within each repetition so that a slow spell
+of the shared machine touches all of them alike. Each configuration's error is its MSE (over
+pixels and channels) against that renderer's own converged reference, less the reference's
+own expected error, averaged over the repetitions; its time is the process's CPU time
+(user + system) at SPP spp less that at 1 spp (the setup: parsing, grid loading, majorant
+structures, image writing), medians over the repetitions, scaled by SPP / (SPP - 1).
+Efficiency is 1 / (MSE * time), also given relative to pbrt-v4 on the same scene.
+
+References are rendered once (all threads, seeds 977 and 978, REF_SPP/2 spp each; their
+average is the reference and a quarter of the two halves' MSE is its expected error) and cached
+in OUT/refs, keyed by the scene file's contents, the overrides and REF_SPP: delete that folder
+after changing a renderer. Two references of the same scene (nimbus spectral mode and pbrt-v4)
+are compared to show that the scenes match: image means, and block means with their z-scores.
+"""
+
+import argparse
+import hashlib
+import json
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+HERE = os.path.join(REPO, "bench", "pbrt")
+
+# nimbus settings: (label, overrides)
+SPECTRUM = {
+    "rgb": ['spectrum.mode="rgb"'],
+    "spectral 4": ['spectrum.mode="spectral"', "spectrum.wavelengths=4"],
+}
+TRACKING = {
+    "spectral-mis": ['integrator.tracking="spectral-mis"', 'integrator.absorption="collide"'],
+    "history + decomposition": [
+        'integrator.tracking="spectral-history"', 'integrator.absorption="weight"',
+        "integrator.decomposition=true", 'integrator.transmittance="residual-ratio"'],
+}
+COMMON = ['integrator.sampler="zsobol"']
+
+# scene key -> (title, nimbus scene, pbrt scene); paths relative to OUT once staged.
+SCENES = {
+    "cloud": ("chromatic cloud (nimbus: its procedural density; pbrt: the 129³ grid)",
+              "chromatic_cloud.json", "chromatic_cloud.pbrt"),
+    "cloud-grid": ("chromatic cloud, the same 129³ grid in both",
+                   "chromatic_cloud_vdb.json", "chromatic_cloud.pbrt"),
+    "marble": ("marble sphere (SSS behind glass, IOR 1.5)", "marble.json", "marble.pbrt"),
+    "skin": ("skin ellipsoid (SSS behind glass, IOR 1.3)", "skin.json", "skin.pbrt"),
+}
+
+
+def log(msg):
+    print(msg, file=sys.stderr, flush=True)
+
+
+def read_pfm(path):
+    with open(path, "rb") as f:
+        assert f.readline().strip() == b"PF"
+        w, h = map(int, f.readline().split())
+        scale = float(f.readline())
+        data = np.fromfile(f, dtype="<f4" if scale < 0 else ">f4", count=w * h * 3)
+    return data.reshape(h, w, 3)[::-1].astype(np.float64)  # top row first
+
+
+def run_timed(cmd, cwd, log_path):
+    """Runs cmd (output to log_path); returns (CPU seconds of the child, wall seconds)."""
+    with open(log_path, "wb") as logf:
+        t0 = time.perf_counter()
+        p = subprocess.Popen(cmd, cwd=cwd, stdout=logf, stderr=subprocess.STDOUT)
+        _, status, ru = os.wait4(p.pid, 0)
+        wall = time.perf_counter() - t0
+        p.returncode = os.waitstatus_to_exitcode(status)
+    if p.returncode != 0:
+        sys.exit("command failed (exit %d): %s\n%s" % (
+            p.returncode, " ".join(cmd), open(log_path, errors="replace").read()[-2000:]))
+    return ru.ru_utime + ru.ru_stime, wall
+
+
+class Ctx:
+    def __init__(self, a):
+        self.a = a
+        self.out = os.path.abspath(a.out)
+        self.tmp = os.path.join(self.out, "tmp")
+        self.refs = os.path.join(self.out, "refs")
+        os.makedirs(self.tmp, exist_ok=True)
+        os.makedirs(self.refs, exist_ok=True)
+        self.exr_to_pfm = a.exr_to_pfm
+
+    def to_array(self, exr):
+        pfm = exr[:-4] + ".pfm"
+        subprocess.run([self.exr_to_pfm, exr, pfm], check=True)
+        return read_pfm(pfm)
+
+    # One render; returns (image, cpu seconds, wall seconds, stats or None).
+    def render(self, r, spp, seed, threads, tag):
+        exr = os.path.join(self.tmp, tag + ".exr")
+        if r["renderer"] == "nimbus":
+            stats = os.path.join(self.tmp, tag + ".json")
+            cmd = [self.a.nimbus, "render", r["scene"], "-o", exr, "--spp", str(spp),
+                   "--seed", str(seed), "--threads", str(threads), "--quiet", "--stats", stats]
+            for o in r["overrides"]:
+                cmd += ["--set", o]
+        else:
+            stats = None
+            cmd = [self.a.pbrt, "--nthreads", str(threads), "--spp", str(spp), "--seed",
+                   str(seed), "--outfile", exr, "--quiet", r["scene"]]
+        cpu, wall = run_timed(cmd, self.out, os.path.join(self.tmp, tag + ".log"))
+        img = self.to_array(exr)
+        st = json.load(open(stats)) if stats else None
+        return img, cpu, wall, st
+
+    def reference(self, c):
+        r = dict(c, overrides=c["ref_overrides"])
+        key = hashlib.sha1(open(os.path.join(self.out, r["scene"]), "rb").read())
+        key.update(("|".join(r["overrides"]) + "|%d" % self.a.ref_spp).encode())
+        name = "%s-%s-%s" % (r["renderer"], os.path.splitext(r["scene"])[0], key.hexdigest()[:12])
+        path = os.path.join(self.refs, name + ".npz")
+        if os.path.exists(path):
+            z = np.load(path)
+            return z["mean"], float(z["noise"]), z["pixel_var"]
+        half = max(1, self.a.ref_spp // 2)
+        log("reference: %s, %s, 2 x %d spp on %d threads..." % (
+            r["label"], r["scene"], half, self.a.ref_threads))
+        t0 = time.time()
+        h1 = self.render(r, half, 977, self.a.ref_threads, name + "-h1")[0]
+        h2 = self.render(r, half, 978, self.a.ref_threads, name + "-h2")[0]
+        mean = 0.5 * (h1 + h2)
+        pixel_var = 0.25 * (h1 - h2) ** 2  # an unbiased estimate of each pixel's variance
+        noise = float(pixel_var.mean())
+        np.savez(path, mean=mean, noise=noise, pixel_var=pixel_var)
+        log("  %.0f s, noise %.3e" % (time.time() - t0, noise))
+        return mean, noise, pixel_var
+
+
+def stage(ctx):
+    """Copies the scenes into OUT and makes the cloud's grid (VDB for nimbus, NanoVDB for pbrt)."""
+    out = ctx.out
+    for f in ("chromatic_cloud.json", "marble.json", "skin.json"):
+        shutil.copyfile(os.path.join(REPO, "scenes", "bench", f), os.path.join(out, f))
+    for f in ("chromatic_cloud_vdb.json", "chromatic_cloud.pbrt", "marble.pbrt", "skin.pbrt"):
+        shutil.copyfile(os.path.join(HERE, f), os.path.join(out, f))
+    src = os.path.join(out, "chromatic_cloud.json")
+    stamp = os.path.join(out, "chromatic_cloud.grid-stamp")
+    key = hashlib.sha1(open(src, "rb").read() + str(ctx.a.voxel_size).encode()).hexdigest()
+    vdb = os.path.join(out, "chromatic_cloud.vdb")
+    nvdb = os.path.join(out, "chromatic_cloud.nvdb")
+    if not (os.path.exists(stamp) and open(stamp).read() == key and os.path.exists(vdb)
+            and os.path.exists(nvdb)):
+        log("exporting the cloud's density (voxel size %g)..." % ctx.a.voxel_size)
+        subprocess.run([ctx.a.nimbus, "export-vdb", src, "-o", vdb, "--voxel-size",
+                        repr(ctx.a.voxel_size), "--quiet"], check=True)
+        subprocess.run([ctx.a.vdb_tool, "-read", vdb, "-write", "codec=none", "bits=32", nvdb],
+                       check=True, stdout=subprocess.DEVNULL)
+        open(stamp, "w").write(key)
+
+
+def configs(scene_key):
+    title, nscene, pscene = SCENES[scene_key]
+    cs = [{"renderer": "pbrt", "label": "pbrt-v4", "spectrum": "spectral 4",
+           "tracking": "spectral MIS (volpath)", "scene": pscene, "overrides": [],
+           "ref_overrides": []}]
+    for sp, so in SPECTRUM.items():
+        for tr, to in TRACKING.items():
+            # One reference per spectrum mode (the expected image does not depend on the
+            # tracking estimator): spectral MIS's.
+            cs.append({"renderer": "nimbus", "label": "nimbus %s" % sp, "spectrum": sp,
+                       "tracking": tr, "scene": nscene, "overrides": COMMON + so + to,
+                       "ref_overrides": COMMON + so + TRACKING["spectral-mis"]})
+    return title, cs
+
+
+def block_compare(ref_a, var_a, ref_b, var_b, block):
+    """Per-block, per-channel means of two references: relative differences and z-scores."""
+    h, w, _ = ref_a.shape
+    nb = (h // block) * (w // block)
+    def blocks(x):
+        return x[: h // block * block, : w // block * block].reshape(
+            h // block, block, w // block, block, 3).sum(axis=(1, 3))
+    n = block * block
+    ma, mb = blocks(ref_a) / n, blocks(ref_b) / n
+    va, vb = blocks(var_a) / n ** 2, blocks(var_b) / n ** 2
+    diff = mb - ma
+    z = diff / np.sqrt(va + vb + 1e-30)
+    lum = lambda m: 0.2126 * m[..., 0] + 0.7152 * m[..., 1] + 0.0722 * m[..., 2]
+    la, lb = lum(ma), lum(mb)
+    rel = (lb - la) / np.maximum(la, 1e-6)
+    bright = la > 0.1 * la.max()
+    return {"blocks": nb, "max_abs_z": float(np.abs(z).max()),
+            "rms_z": float(np.sqrt((z ** 2).mean())),
+            "lum_rel_rms": float(np.sqrt((rel[bright] ** 2).mean())),
+            "lum_rel_max": float(np.abs(rel[bright]).max()),
+            "n_bright": int(bright.sum())}
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--pbrt", required=True)
+    ap.add_argument("--nimbus", required=True)
+    ap.add_argument("--vdb-tool", dest="vdb_tool", default="vdb_tool")
+    ap.add_argument("--exr-to-pfm", dest="exr_to_pfm", required=True)
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--spp", type=int, default=64)
+    ap.add_argument("--ref-spp", dest="ref_spp", type=int, default=4096)
+    ap.add_argument("--ref-threads", dest="ref_threads", type=int, default=os.cpu_count() or 1)
+    ap.add_argument("--reps", type=int, default=5)
+    ap.add_argument("--voxel-size", dest="voxel_size", type=float, default=1 / 64)
+    ap.add_argument("--json", default=None, help="also write the raw results here")
+    ap.add_argument("scenes", nargs="*", default=list(SCENES))
+    a = ap.parse_args()
+    for s in a.scenes:
+        if s not in SCENES:
+            sys.exit("unknown scene %r (known: %s)" % (s, ", ".join(SCENES)))
+    ctx = Ctx(a)
+    stage(ctx)
+
+    results = {}
+    for s in a.scenes:
+        title, cs = configs(s)
+        for c in cs:
+            c["ref"], c["ref_noise"], c["ref_var"] = ctx.reference(c)
+        results[s] = (title, cs)
+
+    # Timed renders: every repetition runs every configuration of every scene, interleaved.
+    for rep in range(a.reps):
+        log("repetition %d of %d" % (rep + 1, a.reps))
+        for s in a.scenes:
+            for i, c in enumerate(results[s][1]):
+                img, cpu, wall, st = ctx.render(c, a.spp, 1 + rep, 1, "%s-%d" % (s, i))
+                _, cpu1, wall1, _ = ctx.render(c, 1, 1 + rep, 1, "%s-%d-setup" % (s, i))
+                mse = float(((img - c["ref"]) ** 2).mean()) - c["ref_noise"]
+                c.setdefault("mse", []).append(mse)
+                c.setdefault("cpu", []).append(cpu)
+                c.setdefault("wall", []).append(wall)
+                c.setdefault("cpu1", []).append(cpu1)
+                c.setdefault("mean", []).append(img.mean(axis=(0, 1)))
+                if st:
+                    c.setdefault("nimbus_wall", []).append(st["wall_seconds"])
+
+    load = open("/proc/loadavg").read().split()[:3]
+    print("\n%d × %d pixels, %d spp, one thread each, %d repetitions (seeds 1–%d); references "
+          "%d spp; load average at the end %s.\n" % (
+              64, 64, a.spp, a.reps, a.reps, a.ref_spp, " ".join(load)))
+    raw = {}
+    for s in a.scenes:
+        title, cs = results[s]
+        print("### %s\n" % title)
+        print("| renderer | spectrum | tracking | time (s) | setup (s) | MSE | efficiency "
+              "1/(MSE·s) | × pbrt-v4 |")
+        print("|---|---|---|---|---|---|---|---|")
+        base = None
+        for c in cs:
+            t64 = statistics.median(c["cpu"])
+            t1 = statistics.median(c["cpu1"])
+            t = max(t64 - t1, 1e-9) * a.spp / max(a.spp - 1, 1)
+            mse = statistics.fmean(c["mse"])
+            eff = 1 / (mse * t)
+            if base is None:
+                base = eff
+            c.update(time=t, setup=t1, mse_mean=mse, eff=eff, rel=eff / base)
+            print("| %s | %s | %s | %.3f | %.3f | %.3e | %.3g | **%.2f** |" % (
+                c["renderer"], c["spectrum"], c["tracking"], t, t1, mse, eff, eff / base))
+        # How well the scenes match: the references' means.
+        pb = cs[0]
+        print("\nReferences (%d spp; noise = the expected MSE of the reference itself):\n" % a.ref_spp)
+        print("| reference | image mean (R, G, B) | vs pbrt-v4 (R, G, B) | noise |")
+        print("|---|---|---|---|")
+        for c in cs:
+            if c["renderer"] == "nimbus" and c["tracking"] != "spectral-mis":
+                continue  # one reference per nimbus spectrum mode is enough here
+            m = c["ref"].mean(axis=(0, 1))
+            rel = (m - pb["ref"].mean(axis=(0, 1))) / pb["ref"].mean(axis=(0, 1))
+            print("| %s %s | %.4f, %.4f, %.4f | %+.2f %%, %+.2f %%, %+.2f %% | %.1e |" % (
+                c["renderer"], c["spectrum"], *m, *(100 * rel), c["ref_noise"]))
+        nspec = [c for c in cs if c["renderer"] == "nimbus" and c["spectrum"] == "spectral 4"
+                 and c["tracking"] == "spectral-mis"][0]
+        nrgb = [c for c in cs if c["renderer"] == "nimbus" and c["spectrum"] == "rgb"
+                and c["tracking"] == "spectral-mis"][0]
+        cmp = {}
+        for label, c in (("nimbus spectral 4", nspec), ("nimbus rgb", nrgb)):
+            for b in (16, 8):
+                r = block_compare(pb["ref"], pb["ref_var"], c["ref"], c["ref_var"], b)
+                cmp["%s/%d" % (label, b)] = r
+                print("\n%s against pbrt-v4, %d blocks of %d × %d pixels: block luminance "
+                      "differs by %.2f %% rms, at most %.2f %% (over the %d blocks brighter "
+                      "than a tenth of the brightest); per-channel z-scores rms %.2f, max %.2f."
+                      % (label, r["blocks"], b, b, 100 * r["lum_rel_rms"],
+                         100 * r["lum_rel_max"], r["n_bright"], r["rms_z"], r["max_abs_z"]),
+                      end="")
+        print("\n")
+        raw[s] = {"title": title, "compare": cmp, "configs": [
+            {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in c.items()
+             if k not in ("ref", "ref_var")} for c in cs]}
+    if a.json:
+        def conv(o):
+            if isinstance(o, np.ndarray):
+                return o.tolist()
+            if isinstance(o, np.generic):
+                return o.item()
+            raise TypeError(type(o))
+        json.dump(raw, open(a.json, "w"), indent=1, default=conv)
+
+
+if __name__ == "__main__":
+    main()
