@@ -24,7 +24,9 @@
 // it, an interior node a step plus its children's costs weighted by the chance a ray crossing
 // the node crosses them.
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -113,55 +115,57 @@ MajorantOctree build_majorant_octree(std::span<const Medium> media,
 // Calls leaf(node index, a, b) for every non-empty leaf the ray crosses in [t_min, t_max], front to
 // back, with [a, b] the ray's stretch inside it; consecutive stretches share their end points
 // exactly. leaf returns false to stop; then so does the walk.
+//
+// Each stretch starts with a descent from the root to the leaf the ray is in just after t: per
+// level one comparison per axis, no stack. A node's mid-plane k is crossed at
+// (center[k] − o[k]) / d[k]; the ray is on the plane's upper side just after t when that
+// crossing is at or before t (d[k] > 0) or after t (d[k] < 0). The leaf's exit is the nearest
+// such crossing after t over the levels descended, so the next descent, at that exit, takes
+// the same crossing on its other side: stretches meet exactly and every step makes progress.
+// (A descent costs about depth × 3 branch-free steps; the stack walk it replaced spent several
+// unpredictable branches per level on children it then mostly did not visit.)
 template <class Leaf>
 bool walk_octree(const MajorantOctree& tree, const Ray& ray, double t_min, double t_max,
                  Leaf&& leaf) {
   if (tree.nodes.empty()) return true;
-  double t0 = t_min, t1 = t_max;
-  if (!clip_ray(tree.box, ray, t0, t1) || !(t1 > t0)) return true;
   Vec3 inv;
-  for (int k = 0; k < 3; ++k) inv[k] = 1.0 / ray.d[k];
-  struct Item {
-    std::int32_t node;
-    int level;
-    Vec3 center;
-    double t0, t1;
-  };
-  // Every interior node pops once and pushes at most 4 children: 3 per level stay behind.
-  Item stack[3 * kOctreeMaxDepth + 4];
-  int top = 0;
-  stack[top++] = {0, 0, tree.box.center(), t0, t1};
-  while (top > 0) {
-    const Item it = stack[--top];
-    const OctreeNode& node = tree.nodes[it.node];
-    if (node.children < 0) {
-      if (!node.empty && !leaf(it.node, it.t0, it.t1)) return false;
-      continue;
-    }
-    // The ray crosses the three mid-planes in order; between crossings it is in one child.
-    double cuts[5] = {it.t0, 0, 0, 0, 0};
-    int n = 1;
-    for (int k = 0; k < 3; ++k) {
-      const double t = (it.center[k] - ray.o[k]) * inv[k];
-      if (t > it.t0 && t < it.t1) cuts[n++] = t;
-    }
-    for (int i = 2; i < n; ++i)
-      for (int j = i; j > 1 && cuts[j] < cuts[j - 1]; --j) std::swap(cuts[j], cuts[j - 1]);
-    cuts[n] = it.t1;
-    const Vec3& half = tree.half[it.level + 1];
-    for (int i = n - 1; i >= 0; --i) {
-      const double a = cuts[i], b = cuts[i + 1];
-      if (!(b > a)) continue;
-      const Vec3 p = ray.at(0.5 * (a + b));
+  std::array<bool, 3> down{};  // the ray runs towards lower k (a direction of −0 counts)
+  double t = t_min, t_end = t_max;
+  for (int k = 0; k < 3; ++k) {
+    inv[k] = 1.0 / ray.d[k];
+    down[k] = std::signbit(inv[k]);
+    // The root box's slab; NaN (a zero direction with the origin on a face) keeps the interval.
+    double ta = (tree.box.lo[k] - ray.o[k]) * inv[k], tb = (tree.box.hi[k] - ray.o[k]) * inv[k];
+    if (down[k]) std::swap(ta, tb);
+    if (ta > t) t = ta;
+    if (tb < t_end) t_end = tb;
+  }
+  const Vec3 root = tree.box.center();
+  while (t < t_end) {
+    std::int32_t node = 0;
+    Vec3 c = root;
+    // The leaf's faces, [k][0] lower and [k][1] upper: each the very double that a descent
+    // compares against, an ancestor's mid-plane or the root's face.
+    double faces[3][2] = {{tree.box.lo.x, tree.box.hi.x},
+                          {tree.box.lo.y, tree.box.hi.y},
+                          {tree.box.lo.z, tree.box.hi.z}};
+    for (int level = 1; tree.nodes[node].children >= 0; ++level) {
       int octant = 0;
-      Vec3 c = it.center;
       for (int k = 0; k < 3; ++k) {
-        const bool upper = p[k] >= it.center[k];
-        octant |= upper << k;
-        c[k] += upper ? half[k] : -half[k];
+        // With d[k] = ±0 the crossing is ±inf (or NaN on the plane): the side of o[k] is taken.
+        const bool upper = ((c[k] - ray.o[k]) * inv[k] <= t) != down[k];
+        octant |= int(upper) << k;
+        faces[k][!upper] = c[k];
+        const double step[2] = {-tree.half[level][k], tree.half[level][k]};
+        c[k] += step[upper];
       }
-      stack[top++] = {node.children + octant, it.level + 1, c, a, b};
+      node = tree.nodes[node].children + octant;
     }
+    // The exit: the nearest crossing of the faces ahead (NaN for a zero direction: skipped).
+    double exit = t_end;
+    for (int k = 0; k < 3; ++k) exit = std::min(exit, (faces[k][!down[k]] - ray.o[k]) * inv[k]);
+    if (!tree.nodes[node].empty && !leaf(node, t, exit)) return false;
+    t = exit;
   }
   return true;
 }
