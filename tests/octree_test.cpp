@@ -500,6 +500,35 @@ TEST(Octree, ConstantMediumInTheFieldIsOneNodeWalkedOnlyInside) {
   EXPECT_TRUE(walk(scene, {{-2, 1.2, 0}, {1, 0, 0}}, 0, 10).segments.empty());
 }
 
+// A leaf marked filled is walked without clipping to the objects' insides (medium_field.h), so
+// an object's F must be > 0 at every point of it.
+TEST(Octree, FilledLeavesLieInsideAnObject) {
+  const Scene scene = three_media(6);
+  const MajorantOctree& tree = scene.field_octree;
+  Rng rng(11, 0);
+  int filled = 0, crossed = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3 p = point_in(tree.box, rng);
+    int leaf = 0;
+    descend(tree, p, [&](int index, int) { leaf = index; });
+    const OctreeNode& node = tree.nodes[leaf];
+    if (node.empty) continue;
+    bool inside = false;
+    for (int o : scene.field_objects)
+      inside =
+          inside || (scene.objects[o].bounds.contains(p) && evaluate(scene.objects[o].tape, p) > 0);
+    if (node.filled) {
+      ++filled;
+      EXPECT_TRUE(inside) << "a filled leaf holds a point outside every object";
+    } else {
+      crossed += !inside;
+    }
+  }
+  // Both kinds are there: filled leaves deep inside, and leaves that surfaces cross.
+  EXPECT_GT(filled, 1000);
+  EXPECT_GT(crossed, 100);
+}
+
 TEST(Octree, MajorantScaleMultipliesTheWalkedMajorants) {
   Scene scene = three_media(3);
   const Ray ray{{-3, 0.1, 0.05}, normalize(Vec3{1, 0.02, 0.01})};

@@ -137,8 +137,10 @@ MediumIntervals field_medium_intervals(const S& scene, const Ray& ray, double t_
 // in [t_min, t_max], in order, from the leaves of the scene's majorant octree (octree.h) for
 // `inside` (-1: the field; else that solid object), each channel taking its bin's bounds. Where
 // no medium can be there is a gap: in the field, the leaves' stretches are clipped to where an
-// object's F > 0 (field_medium_intervals), which the octree's minorants rely on; inside a solid
-// the ray never leaves the object. Neighbouring leaves with identical bounds become one segment.
+// object's F > 0 (field_medium_intervals), which the octree's minorants rely on, except in
+// leaves that an object fills (no surface crosses them), so a walk that stays in such leaves
+// finds no roots; inside a solid the ray never leaves the object. Neighbouring leaves with
+// identical bounds become one segment.
 // f returns false to stop the walk. The ray direction must be unit length.
 template <int N, MediaScene S, class F>
 void walk_majorant_segments(const S& scene, const Channels<N>& ch, const Ray& ray, double t_min,
@@ -147,15 +149,16 @@ void walk_majorant_segments(const S& scene, const Channels<N>& ch, const Ray& ra
   // at(): a scene whose octrees were never built fails loudly rather than reading past the end.
   const MajorantOctree& tree = inside >= 0 ? scene.solid_octrees.at(inside) : scene.field_octree;
   if (tree.nodes.empty()) return;
+  // In the field, the objects' spans are found (by root finding) only once the walk meets a
+  // leaf that an object's surface may cross: a walk within filled leaves needs none.
   MediumIntervals spans;
-  if (inside >= 0) {
+  bool have_spans = inside >= 0;
+  double t0 = t_min, t1 = t_max;
+  if (have_spans) {
     spans.count = 1;
     spans.spans[0] = {t_min, t_max};
-  } else {
-    double t0 = t_min, t1 = t_max;
-    if (!clip_ray(tree.box, ray, t0, t1) || !(t1 > t0)) return;
-    spans = field_medium_intervals(scene, ray, t0, t1);
-    if (spans.count == 0) return;
+  } else if (!clip_ray(tree.box, ray, t0, t1) || !(t1 > t0)) {
+    return;
   }
   const double scale = tree.majorant_scale;
   MajorantSegment<N> pending{0, 0, Spectrum<N>(0.0), Spectrum<N>(0.0)};
@@ -172,24 +175,28 @@ void walk_majorant_segments(const S& scene, const Channels<N>& ch, const Ray& ra
     has_pending = true;
     return true;
   };
-  walk_octree(tree, ray, spans.spans[0].first, spans.spans[spans.count - 1].second,
-              [&](std::int32_t node, double a, double b) {
-                while (span < spans.count && spans.spans[span].second <= a) ++span;
-                if (span == spans.count) return false;
-                if (spans.spans[span].first >= b) return true;
-                const double* hi = tree.mu_bar(node);
-                const double* lo = tree.mu_c(node);
-                Spectrum<N> mu_bar, mu_c;
-                for (int c = 0; c < N; ++c) {
-                  mu_bar[c] = hi[ch.bin[c]] * scale;
-                  mu_c[c] = lo[ch.bin[c]];
-                }
-                for (int k = span; k < spans.count && spans.spans[k].first < b; ++k)
-                  if (!emit(std::max(a, spans.spans[k].first), std::min(b, spans.spans[k].second),
-                            mu_bar, mu_c))
-                    return false;
-                return true;
-              });
+  walk_octree(tree, ray, t0, t1, [&](std::int32_t node, double a, double b) {
+    const double* hi = tree.mu_bar(node);
+    const double* lo = tree.mu_c(node);
+    Spectrum<N> mu_bar, mu_c;
+    for (int c = 0; c < N; ++c) {
+      mu_bar[c] = hi[ch.bin[c]] * scale;
+      mu_c[c] = lo[ch.bin[c]];
+    }
+    if (tree.nodes[node].filled) return emit(a, b, mu_bar, mu_c);
+    if (!have_spans) {
+      spans = field_medium_intervals(scene, ray, t0, t1);
+      have_spans = true;
+    }
+    while (span < spans.count && spans.spans[span].second <= a) ++span;
+    if (span == spans.count) return false;
+    if (spans.spans[span].first >= b) return true;
+    for (int k = span; k < spans.count && spans.spans[k].first < b; ++k)
+      if (!emit(std::max(a, spans.spans[k].first), std::min(b, spans.spans[k].second), mu_bar,
+                mu_c))
+        return false;
+    return true;
+  });
   // The walk also stops once past the last span; a pending segment is then still due.
   if (!stopped && has_pending) f(std::as_const(pending));
 }

@@ -70,16 +70,20 @@ constexpr double kRoundOff = 1e-12;
 
 // Bounds of mu_t over a box, the sum over members of sigma_t times their density range there,
 // into out[0, bins) (majorants) and out[bins, 2 bins) (minorants). False if no medium can be
-// in the box.
+// in the box. `filled`: some member's F > 0 over the whole box, within its bounds.
 bool interval_bounds(const std::vector<Member>& members, const Box& box, bool solid, int bins,
-                     double* out) {
+                     double* out, bool& filled) {
   std::fill(out, out + 2 * bins, 0.0);
   // Where one member alone may be present, the clipped walk sees only its inside; where several
   // may, a point inside one of them can be outside another.
   int present = 0;
+  filled = false;
   for (const Member& m : members) {
     const Box b = intersect(m.object->bounds, box);
-    present += !b.empty() && evaluate(*m.object->tape, b).hi > 0;
+    if (b.empty()) continue;
+    const Interval F = evaluate(*m.object->tape, b);
+    present += F.hi > 0;
+    filled = filled || (F.lo > 0 && b.lo == box.lo && b.hi == box.hi);
   }
   bool any = false;
   for (const Member& m : members) {
@@ -311,7 +315,7 @@ MajorantOctree build_majorant_octree(std::span<const Medium> media,
 
   auto make_node = [&](const Vec3& center, const Vec3& half, double* bounds) {
     OctreeNode n;
-    n.empty = !interval_bounds(members, box_of(center, half), solid, bins, bounds);
+    n.empty = !interval_bounds(members, box_of(center, half), solid, bins, bounds, n.filled);
     return n;
   };
   // Node centers are computed as the walk computes them, so both see the same boxes.

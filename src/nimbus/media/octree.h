@@ -59,7 +59,9 @@ struct OctreeNode {
   // The first of 8 contiguous children, child k in octant (k & 1: upper x, k & 2: upper y,
   // k & 4: upper z); -1 for a leaf.
   std::int32_t children = -1;
-  bool empty = true;  // no medium can be in the node
+  bool empty = true;    // no medium can be in the node
+  bool filled = false;  // an object's F > 0 all over the node: a walk in the field needs no
+                        // clipping to the objects' insides there (medium_field.h)
 };
 
 // Bounds are kept per bin: in rgb mode the three channels; in spectral mode kSpectralBins
