@@ -52,8 +52,12 @@ inline constexpr double kSampledResidualFloor = 0.05;
 // The sampling pass (source "sample") looks up at most this many points in all, spreading them
 // over the leaves: fewer than majorant_samples per leaf in deep trees.
 inline constexpr size_t kOctreeSampleBudget = size_t{1} << 24;
-// What a density lookup costs in steps of the walk, for deciding which splits pay off.
-inline constexpr double kOctreeLookupCost = 16;
+// What a density lookup costs in steps of the walk, for deciding which splits pay off. Measured
+// (docs/benchmarks.md, "Majorant octree"): a procedural cloud lookup about 100 ns against about
+// 10 ns per level of a walk's descent plus the tracker's work per segment; at 4 no depth of the
+// octree-depth experiment renders slower than a shallower one (at 16, depth 8 was 11 % slower
+// than depth 4).
+inline constexpr double kOctreeLookupCost = 4;
 
 struct OctreeNode {
   // The first of 8 contiguous children, child k in octant (k & 1: upper x, k & 2: upper y,
