@@ -88,6 +88,9 @@ std::string scene_with(const std::string& density = R"({"type": "field", "scale"
 TEST_F(VdbCli, ABadVdbFileExitsTwoWithOneLineAndNoOutput) {
   nimbus::test::write_ball_vdb(file("ball.vdb"), 8, 0.1, {0, 0, 0});
   write("text.vdb", "not a volume\n");
+  // A file the VDB fuzzer damaged: OpenVDB would allocate 13 GB reading it (vdb_damaged_test).
+  fs::copy_file(std::string(NIMBUS_SOURCE_DIR) + "/tests/data/vdb_damaged/metadata_length_13gb.vdb",
+                file("damaged.vdb"), fs::copy_options::overwrite_existing);
   struct Case {
     const char* density;
     std::string message;
@@ -99,6 +102,8 @@ TEST_F(VdbCli, ABadVdbFileExitsTwoWithOneLineAndNoOutput) {
        "scene.json: /media/fog/density/file: text.vdb: not a VDB file"},
       {R"({"type": "vdb", "file": "ball.vdb", "grid": "smoke"})",
        R"(scene.json: /media/fog/density/grid: ball.vdb: grid "smoke" is not in the file (the file holds grid "density"))"},
+      {R"({"type": "vdb", "file": "damaged.vdb"})",
+       "scene.json: /media/fog/density/file: damaged.vdb: corrupted OpenVDB file"},
   };
   for (const Case& c : cases) {
     write("scene.json", scene_with(c.density));
@@ -109,7 +114,8 @@ TEST_F(VdbCli, ABadVdbFileExitsTwoWithOneLineAndNoOutput) {
       EXPECT_EQ(r.code, 2) << command << ": " << r.err;
       EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
       EXPECT_EQ(r.err.rfind(c.message, 0), 0u) << "expected \"" << c.message << "\" in: " << r.err;
-      EXPECT_TRUE(outputs({"scene.json", "ball.vdb", "text.vdb"}).empty()) << command;
+      EXPECT_TRUE(outputs({"scene.json", "ball.vdb", "text.vdb", "damaged.vdb"}).empty())
+          << command;
     }
   }
   // The good grid renders.
