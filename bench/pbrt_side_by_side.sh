@@ -46,6 +46,9 @@ if [[ -z "$nimbus" || ! -x "$nimbus" ]]; then
   echo "pbrt_side_by_side: no nimbus binary: build it (cmake --build build --target nimbus) or set NIMBUS" >&2
   exit 2
 fi
+# The driver runs the renderers from its work folder: relative paths would not resolve there.
+nimbus=$(realpath "$nimbus")
+PBRT=$(realpath "$PBRT")
 
 vdb_tool=${VDB_TOOL:-vdb_tool}
 if ! command -v "$vdb_tool" >/dev/null; then
