@@ -594,7 +594,7 @@ TEST(SceneLoad, DefaultsApplyWhereKeysAreOptional) {
   EXPECT_EQ(s.integrator.max_depth, 1000);
   EXPECT_EQ(s.integrator.tracking.absorption, TrackingSettings::Absorption::Weight);
   EXPECT_FALSE(s.integrator.tracking.decomposition);
-  EXPECT_EQ(s.integrator.tracking.transmittance, TrackingSettings::Transmittance::Ratio);
+  EXPECT_EQ(s.integrator.tracking.transmittance, TrackingSettings::Transmittance::ResidualRatio);
   EXPECT_EQ(s.integrator.tracking.majorant_source, TrackingSettings::MajorantSource::Bound);
   EXPECT_EQ(s.integrator.tracking.majorant_samples, 4096);
   EXPECT_EQ(s.integrator.tracking.majorant_scale, 1.0);

@@ -28,7 +28,7 @@ struct TrackingSettings {
   Mode mode = Mode::SpectralMis;
   Absorption absorption = Absorption::Weight;
   bool decomposition = false;
-  Transmittance transmittance = Transmittance::Ratio;
+  Transmittance transmittance = Transmittance::ResidualRatio;
   MajorantSource majorant_source = MajorantSource::Bound;
   int majorant_samples = 4096;  // points per octree leaf for source "sample"
   double majorant_scale = 1;  // multiplies every majorant; < 1 studies majorants that do not bound
