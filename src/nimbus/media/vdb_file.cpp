@@ -176,7 +176,7 @@ IsolationLimits reader_limits(const std::string& file) {
 openvdb::FloatGrid::Ptr read_openvdb_isolated(const std::string& file, const std::string& name,
                                               const std::string& quantity) {
   const IsolationLimits limits = reader_limits(file);
-  const IsolatedResult r = call_isolated(
+  IsolatedResult r = call_isolated(
       [&]() -> std::string {
         try {
           const openvdb::FloatGrid::Ptr grid = read_openvdb(file, name, quantity);
@@ -218,7 +218,9 @@ openvdb::FloatGrid::Ptr read_openvdb_isolated(const std::string& file, const std
     const std::size_t eol = r.bytes.find('\n');
     throw VdbError(r.bytes.substr(1, eol - 1), r.bytes.substr(eol + 1));
   }
-  std::istringstream in(r.bytes.substr(1), std::ios::binary);
+  // The grid's bytes are moved, not copied, into the stream; the 'G' before them is skipped.
+  std::istringstream in(std::move(r.bytes), std::ios::binary);
+  in.ignore(1);
   openvdb::io::Stream stream(in, /*delayLoad=*/false);
   return openvdb::gridPtrCast<openvdb::FloatGrid>(stream.getGrids()->at(0));
 }
