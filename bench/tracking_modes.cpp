@@ -32,8 +32,9 @@ struct Mode {
   std::vector<std::string> overrides;
 };
 
-// Shadow rays are ratio-tracked unless the name says residual ratio tracking, so that the
-// tables in docs/benchmarks.md, made before residual ratio tracking became the default, compare.
+// Shadow rays are ratio-tracked unless the name says residual ratio tracking or ray marching, so
+// that the tables in docs/benchmarks.md, made before residual ratio tracking became the default,
+// compare.
 const std::vector<Mode> kModes = {
     {"delta",
      {"integrator.tracking=\"delta\"", "integrator.absorption=\"collide\"",
@@ -44,6 +45,9 @@ const std::vector<Mode> kModes = {
     {"spectral-max",
      {"integrator.tracking=\"spectral-max\"", "integrator.absorption=\"weight\"",
       "integrator.transmittance=\"ratio\""}},
+    {"delta, unbiased ray marching",
+     {"integrator.tracking=\"delta\"", "integrator.absorption=\"collide\"",
+      "integrator.transmittance=\"ray-marching\""}},
     {"spectral-history (collide)",
      {"integrator.tracking=\"spectral-history\"", "integrator.absorption=\"collide\"",
       "integrator.transmittance=\"ratio\""}},
@@ -53,6 +57,9 @@ const std::vector<Mode> kModes = {
     {"spectral-history, residual ratio tracking",
      {"integrator.tracking=\"spectral-history\"", "integrator.absorption=\"weight\"",
       "integrator.transmittance=\"residual-ratio\""}},
+    {"spectral-history, unbiased ray marching",
+     {"integrator.tracking=\"spectral-history\"", "integrator.absorption=\"weight\"",
+      "integrator.transmittance=\"ray-marching\""}},
     {"spectral-history + decomposition",
      {"integrator.tracking=\"spectral-history\"", "integrator.absorption=\"weight\"",
       "integrator.decomposition=true", "integrator.transmittance=\"residual-ratio\""}},

@@ -36,6 +36,7 @@ struct ModeCase {
   double majorant_scale;
   int octree_depth;
   bool sampled_majorant = false;  // the paper's short sampling pass instead of interval bounds
+  bool ray_marching = false;      // shadow rays by unbiased ray marching
 };
 
 TrackingSettings tracking_of(const ModeCase& c) {
@@ -46,6 +47,7 @@ TrackingSettings tracking_of(const ModeCase& c) {
     t.majorant_source = TrackingSettings::MajorantSource::Sample;
     t.majorant_samples = 64;  // few, so that some leaves' majorants miss the maximum
   }
+  if (c.ray_marching) t.transmittance = TrackingSettings::Transmittance::RayMarching;
   return t;
 }
 
@@ -59,7 +61,8 @@ std::string mode_name(const testing::TestParamInfo<ModeCase>& info) {
   return std::string(mode) +
          (c.absorption == TrackingSettings::Absorption::Collide ? "Collide" : "Weight") +
          (c.decomposition ? "Decomposition" : "") + (c.majorant_scale < 1 ? "Unbounded" : "") +
-         (c.sampled_majorant ? "Sampled" : "") + "Depth" + std::to_string(c.octree_depth);
+         (c.sampled_majorant ? "Sampled" : "") + (c.ray_marching ? "RayMarching" : "") + "Depth" +
+         std::to_string(c.octree_depth);
 }
 
 // Bounds on the standard error of a render's image mean (see expect_mean), about twice the
@@ -92,6 +95,11 @@ std::vector<ModeCase> mode_cases() {
         for (double scale : {1.0, 0.5}) out.push_back({mode, absorption, decomposition, scale, 4});
   for (double scale : {1.0, 0.5}) out.push_back({M::SpectralMis, A::Collide, false, scale, 4});
   out.push_back({M::SpectralHistory, A::Weight, true, 1.0, 4, true});
+  // Ray marching needs no bounding majorant: Woodcock's clamping tracker is not run at 0.5.
+  out.push_back({M::Delta, A::Collide, false, 1.0, 4, false, true});
+  out.push_back({M::Delta, A::Weight, false, 0.5, 4, false, true});
+  for (double scale : {1.0, 0.5})
+    out.push_back({M::SpectralHistory, A::Weight, true, scale, 4, false, true});
   for (int depth : {0, 12}) {
     out.push_back({M::Delta, A::Collide, false, 1.0, depth});
     out.push_back({M::SpectralHistory, A::Weight, true, 1.0, depth});

@@ -23,7 +23,7 @@ namespace nimbus {
 struct TrackingSettings {
   enum class Mode { Delta, SpectralMax, SpectralHistory, SpectralMis };
   enum class Absorption { Collide, Weight };
-  enum class Transmittance { Ratio, ResidualRatio };
+  enum class Transmittance { Ratio, ResidualRatio, RayMarching };
   enum class MajorantSource { Bound, Sample };
   Mode mode = Mode::SpectralMis;
   Absorption absorption = Absorption::Weight;

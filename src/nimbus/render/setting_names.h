@@ -21,9 +21,10 @@ inline constexpr std::array<std::pair<std::string_view, TrackingSettings::Absorp
     kAbsorptionNames = {{{"weight", TrackingSettings::Absorption::Weight},
                          {"collide", TrackingSettings::Absorption::Collide}}};
 
-inline constexpr std::array<std::pair<std::string_view, TrackingSettings::Transmittance>, 2>
+inline constexpr std::array<std::pair<std::string_view, TrackingSettings::Transmittance>, 3>
     kTransmittanceNames = {{{"ratio", TrackingSettings::Transmittance::Ratio},
-                            {"residual-ratio", TrackingSettings::Transmittance::ResidualRatio}}};
+                            {"residual-ratio", TrackingSettings::Transmittance::ResidualRatio},
+                            {"ray-marching", TrackingSettings::Transmittance::RayMarching}}};
 
 inline constexpr std::array<std::pair<std::string_view, TrackingSettings::MajorantSource>, 2>
     kMajorantSourceNames = {{{"bound", TrackingSettings::MajorantSource::Bound},
@@ -33,9 +34,9 @@ inline constexpr std::array<std::pair<std::string_view, SpectralSettings::Mode>,
     kSpectrumModeNames = {
         {{"rgb", SpectralSettings::Mode::Rgb}, {"spectral", SpectralSettings::Mode::Spectral}}};
 
-inline constexpr std::array<std::pair<std::string_view, RenderSettings::Sampler>, 2>
-    kSamplerNames = {{{"zsobol", RenderSettings::Sampler::ZSobol},
-                      {"independent", RenderSettings::Sampler::Independent}}};
+inline constexpr std::array<std::pair<std::string_view, RenderSettings::Sampler>, 2> kSamplerNames =
+    {{{"zsobol", RenderSettings::Sampler::ZSobol},
+      {"independent", RenderSettings::Sampler::Independent}}};
 
 // The name of a value in its table.
 template <class E, size_t K>

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
+#include <vector>
 
 #include "nimbus/math/rng.h"
 #include "nimbus/media/medium_field.h"
@@ -13,6 +15,7 @@
 #include "nimbus/render/scene.h"
 #include "nimbus/tracking/decomposition_tracking.h"
 #include "nimbus/tracking/delta_tracking.h"
+#include "nimbus/tracking/ray_marching_transmittance.h"
 #include "nimbus/tracking/spectral_mis.h"
 #include "nimbus/tracking/spectral_tracking.h"
 #include "nimbus/tracking/transmittance.h"
@@ -159,7 +162,8 @@ MediumEvent<N> sample_collision_mis(const Scene& scene, const PathSpectra<N>& ps
   return ev;
 }
 
-// Transmittance over (0, t_max) by ratio or residual ratio tracking (settings.transmittance),
+// Transmittance over (0, t_max) by ratio, residual ratio tracking or unbiased ray marching
+// (settings.transmittance),
 // and 0 if a surface blocks the way. `light` is the light the shadow ray aims at (it does not
 // block), or -1. `channel` >= 0 (delta tracking once it has chosen its channel): the path's
 // throughput is in that channel alone, so only it is tracked, at its own majorant, with
@@ -176,8 +180,22 @@ Spectrum<N> transmittance(const Scene& scene, const PathSpectra<N>& ps, const Ra
   auto lookup = [&](double t) {
     return volume_detail::as_sample(medium_at(scene, ps.media, ray.at(t), inside));
   };
-  const bool residual =
-      scene.settings.tracking.transmittance == TrackingSettings::Transmittance::ResidualRatio;
+  using Estimator = TrackingSettings::Transmittance;
+  const Estimator estimator = scene.settings.tracking.transmittance;
+  if (estimator == Estimator::RayMarching) {
+    // The whole ray's segments first: the marches spread their points over all of them. The
+    // estimator needs no bounding majorant, so the boost does not apply.
+    thread_local std::vector<MarchSegment<N>> segs;
+    segs.clear();
+    walk_majorant_segments(scene, ps.ch, ray, 0, t_max, inside, [&](const MajorantSegment<N>& s) {
+      ++counters.majorant_segments;
+      segs.push_back({s.t0, s.t1, s.mu_bar, s.mu_c});
+      return true;
+    });
+    return ray_marching_transmittance<N>(lookup, std::span<const MarchSegment<N>>(segs), channel,
+                                         rng, counters.tracking, &weight);
+  }
+  const bool residual = estimator == Estimator::ResidualRatio;
   Spectrum<N> T(channel < 0 ? 1.0 : 0.0);
   if (channel >= 0) T[channel] = 1;
   // The largest value over the tracked channels.
