@@ -64,6 +64,9 @@ const std::vector<Mode> kModes = {
      {"integrator.tracking=\"spectral-history\"", "integrator.absorption=\"weight\"",
       "integrator.decomposition=true", "integrator.transmittance=\"residual-ratio\""}},
     {"spectral-mis", {"integrator.tracking=\"spectral-mis\"", "integrator.absorption=\"collide\""}},
+    {"spectral-mis, every light per vertex",
+     {"integrator.tracking=\"spectral-mis\"", "integrator.absorption=\"collide\"",
+      "integrator.light_sampling=\"all\""}},
 };
 
 // The reference image: pixel means and the mean variance of those means over pixels and

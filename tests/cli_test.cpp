@@ -219,6 +219,9 @@ TEST_F(Cli, RendersDefaultOutputsAndStats) {
     EXPECT_GT(s["image_mean_standard_error"][c].get<double>(), 0);
   }
   EXPECT_GT(s["counters"]["density_lookups"].get<long>(), 0);
+  EXPECT_GT(s["counters"]["shadow_ray_lookups"].get<long>(), 0);
+  EXPECT_LT(s["counters"]["shadow_ray_lookups"].get<long>(),
+            s["counters"]["density_lookups"].get<long>());
   const double null_fraction = s["counters"]["null_collision_fraction"].get<double>();
   EXPECT_TRUE(null_fraction >= 0 && null_fraction < 1);
   EXPECT_GT(s["counters"]["density_lookups_per_real_collision"].get<double>(), 0);

@@ -8,6 +8,7 @@
 #include "nimbus/frep/bounds.h"
 #include "nimbus/frep/primitives.h"
 #include "nimbus/frep/tape.h"
+#include "nimbus/math/constants.h"
 #include "nimbus/render/renderer.h"
 #include "support/stats.h"
 
@@ -106,17 +107,25 @@ TEST(Render, ImageIsBitIdenticalForAnyThreadCount) {
 namespace nimbus {
 namespace {
 
-// A diffuse floor under a sphere light (radius r, radiance L_s) and nothing else: a uniform
-// sphere above the horizon irradiates like a point of intensity π r² L_s at its centre, so the
-// floor's radiance is albedo · L_s r² cos θ / d². Both path tracers (next-event estimation with
-// MIS against BSDF sampling, and spectral MIS's balance heuristic) must reproduce it.
-void expect_sphere_light_on_floor(TrackingSettings::Mode mode) {
+// A diffuse floor under a sphere light (radius r, radiance L_s): a uniform sphere above the
+// horizon irradiates like a point of intensity π r² L_s at its centre, so the floor's radiance
+// is albedo · L_s r² cos θ / d². With `more_lights`, a directional light (albedo E cos / π), a
+// point light (albedo I cos / (π d²)) and an environment L_e join it; the sphere hides its own
+// share of the sky from the floor: albedo L_e (1 − r² cos θ / d²). Both path tracers
+// (next-event estimation with MIS against BSDF sampling, and spectral MIS's balance heuristic)
+// must reproduce it, sampling every light at each vertex or one picked by its fluence.
+void expect_lights_on_floor(TrackingSettings::Mode mode, bool more_lights,
+                            RenderSettings::LightSampling light_sampling) {
   const int size = 16;
   const double r = 0.6, L_s = 5.0, albedo = 0.7;
   const Vec3 c{0.3, 2.0, -0.2};
+  // Placed so that the sphere casts no shadow in view.
+  const Vec3 sun_dir = normalize(Vec3{1, -1, 0}), point{-1.5, 1.0, 1.2};
+  const double E_sun = 1.5, I_point = 0.8, L_env = 0.3;
   Scene scene;
   scene.settings = {size, size, 512, 9, 1000, {}, {}, RenderSettings::Sampler::Independent};
   scene.settings.tracking.mode = mode;
+  scene.settings.light_sampling = light_sampling;
   // Looking down at the floor from the side, past the light; the view is 1 unit wide.
   scene.camera = orthographic_camera({3, 3, 3}, {0, 0, 0}, {0, 1, 0}, 1.0, size, size);
   SceneObject floor;
@@ -131,6 +140,18 @@ void expect_sphere_light_on_floor(TrackingSettings::Mode mode) {
   light.radius = r;
   light.emission = Rgb(L_s);
   scene.lights.push_back(light);
+  if (more_lights) {
+    Light sun, bulb, sky;
+    sun.type = Light::Type::Directional;
+    sun.direction = sun_dir;
+    sun.emission = Rgb(E_sun);
+    bulb.type = Light::Type::Point;
+    bulb.position = point;
+    bulb.emission = Rgb(I_point);
+    sky.type = Light::Type::Environment;
+    sky.emission = Rgb(L_env);
+    scene.lights.insert(scene.lights.end(), {sun, bulb, sky});
+  }
   const RenderResult res = render(scene);
 
   double chi2 = 0;
@@ -146,7 +167,14 @@ void expect_sphere_light_on_floor(TrackingSettings::Mode mode) {
           const Vec3 p = ray.at(-ray.o.y / ray.d.y);
           const Vec3 to_c = c - p;
           const double d2 = dot(to_c, to_c);
-          ref += albedo * L_s * r * r * (to_c.y / std::sqrt(d2)) / d2;
+          const double sphere = r * r * (to_c.y / std::sqrt(d2)) / d2;
+          ref += albedo * L_s * sphere;
+          if (more_lights) {
+            const Vec3 to_b = point - p;
+            const double b2 = dot(to_b, to_b);
+            ref += albedo * kInvPi * (E_sun * -sun_dir.y + I_point * (to_b.y / std::sqrt(b2)) / b2);
+            ref += albedo * L_env * (1 - sphere);
+          }
         }
       ref /= k * k;
       const int p = y * size + x;
@@ -159,12 +187,24 @@ void expect_sphere_light_on_floor(TrackingSettings::Mode mode) {
   EXPECT_LT(chi2, test::chi_square_critical(dof, 1e-4)) << "over " << dof << " pixels";
 }
 
+constexpr auto kAll = RenderSettings::LightSampling::All;
+constexpr auto kOne = RenderSettings::LightSampling::One;
+
 TEST(Render, SphereLightOnDiffuseFloorMatchesClosedForm) {
-  expect_sphere_light_on_floor(TrackingSettings::Mode::Delta);
+  expect_lights_on_floor(TrackingSettings::Mode::Delta, false, kAll);
 }
 
 TEST(Render, SphereLightOnDiffuseFloorMatchesClosedFormWithSpectralMis) {
-  expect_sphere_light_on_floor(TrackingSettings::Mode::SpectralMis);
+  expect_lights_on_floor(TrackingSettings::Mode::SpectralMis, false, kAll);
+}
+
+TEST(Render, FourLightsOnDiffuseFloorMatchClosedForm) {
+  for (auto mode : {TrackingSettings::Mode::Delta, TrackingSettings::Mode::SpectralMis})
+    for (auto light_sampling : {kAll, kOne}) {
+      SCOPED_TRACE(testing::Message() << "mode " << int(mode) << ", one light per vertex "
+                                      << (light_sampling == kOne));
+      expect_lights_on_floor(mode, true, light_sampling);
+    }
 }
 
 }  // namespace

@@ -40,6 +40,9 @@ SPECTRUM = {
 }
 TRACKING = {
     "spectral-mis": ['integrator.tracking="spectral-mis"', 'integrator.absorption="collide"'],
+    "spectral-mis, every light per vertex": [
+        'integrator.tracking="spectral-mis"', 'integrator.absorption="collide"',
+        'integrator.light_sampling="all"'],
     "history + decomposition": [
         'integrator.tracking="spectral-history"', 'integrator.absorption="weight"',
         "integrator.decomposition=true", 'integrator.transmittance="residual-ratio"'],

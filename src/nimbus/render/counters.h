@@ -15,6 +15,7 @@ struct Counters {
   uint64_t scatter_events = 0;     // real scattering events in media
   uint64_t majorant_segments = 0;  // segments of the majorant walk that estimators tracked over
   uint64_t rejected_samples = 0;   // NaN or infinite sample values the film refused (film.h)
+  uint64_t shadow_lookups = 0;     // the shadow rays' share of tracking.lookups
   TrackingCounters tracking;       // tentative collisions, density lookups, clamped probabilities
 
   uint64_t null_collisions() const { return tracking.tentative_collisions - real_collisions; }
@@ -27,6 +28,7 @@ struct Counters {
     scatter_events += o.scatter_events;
     majorant_segments += o.majorant_segments;
     rejected_samples += o.rejected_samples;
+    shadow_lookups += o.shadow_lookups;
     tracking += o.tracking;
     return *this;
   }

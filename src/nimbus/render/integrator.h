@@ -14,6 +14,7 @@
 #include "nimbus/math/rng.h"
 #include "nimbus/media/medium_field.h"
 #include "nimbus/render/counters.h"
+#include "nimbus/render/light_choice.h"
 #include "nimbus/render/path_sampler.h"
 #include "nimbus/render/path_spectra.h"
 #include "nimbus/render/sampling.h"
@@ -64,21 +65,45 @@ std::optional<LightCandidate<N>> light_candidate(const Scene& scene, const PathS
                            on_surface ? offset_origin(scene, p, n, ls->wi) : p};
 }
 
-// Light reaching p along one sample of every light (next-event estimation), times the
-// scattering function `f(wi)` (cosine included for surfaces) and the policy's weight for the
-// shadow ray (its transmittance, and MIS with the sampling of f). Light i's numbers come from
-// its dimensions in the block of `bounce` (SampleDims::light).
+// The light slots of a bounce's sampler dimensions (SampleDims::bounce): one per light, or with
+// one light per vertex, the chosen light's and a slot whose first number picks it.
+inline int light_slots(const Scene& scene) {
+  const int lights = static_cast<int>(scene.lights.size());
+  return scene.settings.light_sampling == RenderSettings::LightSampling::One ? std::min(lights, 2)
+                                                                             : lights;
+}
+
+// The probability with which next-event estimation at p samples light i: 1 when every light is
+// sampled.
+template <int N>
+double light_sampling_pdf(const Scene& scene, const PathSpectra<N>& ps, int i, const Vec3& p) {
+  return scene.settings.light_sampling == RenderSettings::LightSampling::One
+             ? light_choice_pdf(scene, ps, i, p)
+             : 1.0;
+}
+
+// Light reaching p by next-event estimation, times the scattering function `f(wi)` (cosine
+// included for surfaces) and the policy's weight for the shadow ray (its transmittance, and MIS
+// with the sampling of f): one sample of every light, or of one light picked by its fluence at p
+// (light_choice.h), divided by the probability of the pick. A light's numbers come from its slot
+// in the block of `bounce` (SampleDims::light; the picked light takes slot 0, the pick slot 1).
 template <int N, class Policy, class F, class Pdf>
 Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Vec3& p, const Vec3& n,
                          bool on_surface, int inside, const Policy& policy, F&& f, Pdf&& f_pdf,
                          PathSampler& sampler, uint32_t bounce, Counters& counters) {
   Spectrum<N> L(0.0);
-  for (int i = 0; i < static_cast<int>(scene.lights.size()); ++i) {
-    const uint32_t dims = SampleDims::light(bounce, i);
-    const auto cand = light_candidate(scene, ps, i, p, n, on_surface, f,
-                                      sampler.get2d(dims + SampleDims::kLightPoint));
-    if (!cand) continue;
-    const LightSample& ls = cand->ls;
+  // Light i from slot `slot`, picked with probability choice_pdf.
+  auto sample = [&](int i, int slot, double choice_pdf) {
+    const uint32_t dims = SampleDims::light(bounce, slot);
+    auto cand = light_candidate(scene, ps, i, p, n, on_surface, f,
+                                sampler.get2d(dims + SampleDims::kLightPoint));
+    if (!cand) return;
+    LightSample& ls = cand->ls;
+    // The light technique's pdf includes the pick; a delta light's weight has no pdf to carry it.
+    if (ls.delta)
+      cand->Li /= choice_pdf;
+    else
+      ls.pdf *= choice_pdf;
     Spectrum<N> term;
     sampler.first_from(dims + SampleDims::kShadow);
     const bool lit =
@@ -86,6 +111,14 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Vec
                           ls, cand->f * cand->Li, f_pdf, sampler.rng(), counters, term);
     sampler.done();
     if (lit) L += term;
+  };
+  const int lights = static_cast<int>(scene.lights.size());
+  if (scene.settings.light_sampling == RenderSettings::LightSampling::One && lights > 1) {
+    const auto [i, choice_pdf] =
+        choose_light(scene, ps, p, sampler.get1d(SampleDims::light(bounce, 1)));
+    sample(i, 0, choice_pdf);
+  } else {
+    for (int i = 0; i < lights; ++i) sample(i, i, 1.0);
   }
   return L;
 }
@@ -117,7 +150,7 @@ template <int N, class Policy>
 Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, PathSampler& sampler,
                        Counters& counters, Policy& policy) {
   Rng& rng = sampler.rng();
-  const int lights = static_cast<int>(scene.lights.size());
+  const int lights = light_slots(scene);
   Spectrum<N> L(0.0);
   int inside = solid_containing(scene, ray.o);  // the solid (dielectric) the path is in, or -1
   // The last vertex sampled the lights (next-event estimation), so a light the path hits next
@@ -162,12 +195,13 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
     if (!hit) {
       for (size_t i = 0; i < scene.lights.size(); ++i)
         if (scene.lights[i].type == Light::Type::Environment)
-          L += policy.light_hit(ps.lights[i], scene.lights[i], prev_p, ray.d, light_sampled);
+          L += policy.light_hit(ps.lights[i], scene.lights[i], prev_p, ray.d, light_sampled,
+                                light_sampling_pdf(scene, ps, int(i), prev_p));
       break;
     }
     if (hit->light >= 0) {
       L += policy.light_hit(ps.lights[hit->light], scene.lights[hit->light], prev_p, ray.d,
-                            light_sampled);
+                            light_sampled, light_sampling_pdf(scene, ps, hit->light, prev_p));
       break;
     }
     const SceneObject& obj = scene.objects[hit->object];

@@ -47,6 +47,10 @@ struct RenderSettings {
   // Morton order (math/zsobol.h), or independent PCG numbers, whose per-pixel sample variance
   // estimates the variance of the pixel's mean (tests that rely on it ask for it).
   enum class Sampler { ZSobol, Independent };
+  // Next-event estimation at a vertex: a shadow ray to every light, or (the default) to one
+  // light picked in proportion to its unoccluded fluence there, a constant sky left to BSDF and
+  // phase sampling while another light shines (render/light_choice.h).
+  enum class LightSampling { All, One };
   int width = 640, height = 480;
   int spp = 16;
   uint64_t seed = 0;
@@ -54,6 +58,7 @@ struct RenderSettings {
   TrackingSettings tracking;
   SpectralSettings spectral;
   Sampler sampler = Sampler::ZSobol;
+  LightSampling light_sampling = LightSampling::One;
 };
 
 struct SceneObject {

@@ -38,6 +38,10 @@ inline constexpr std::array<std::pair<std::string_view, RenderSettings::Sampler>
     {{{"zsobol", RenderSettings::Sampler::ZSobol},
       {"independent", RenderSettings::Sampler::Independent}}};
 
+inline constexpr std::array<std::pair<std::string_view, RenderSettings::LightSampling>, 2>
+    kLightSamplingNames = {
+        {{"all", RenderSettings::LightSampling::All}, {"one", RenderSettings::LightSampling::One}}};
+
 // The name of a value in its table.
 template <class E, size_t K>
 constexpr std::string_view name_of(const std::array<std::pair<std::string_view, E>, K>& table,

@@ -22,6 +22,7 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
   j["spectrum"] = {{"mode", name_of(kSpectrumModeNames, scene.settings.spectral.mode)},
                    {"channels", spectral ? scene.settings.spectral.wavelengths : 3}};
   j["sampler"] = name_of(kSamplerNames, scene.settings.sampler);
+  j["light_sampling"] = name_of(kLightSamplingNames, scene.settings.light_sampling);
   const TrackingSettings& t = scene.settings.tracking;
   j["tracking"] = {{"mode", name_of(kTrackingModeNames, t.mode)},
                    {"absorption", name_of(kAbsorptionNames, t.absorption)},
@@ -40,6 +41,7 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
       {"shadow_rays", c.shadow_rays},
       {"path_segments", c.tracking.tentative_collisions},
       {"density_lookups", c.tracking.lookups},
+      {"shadow_ray_lookups", c.shadow_lookups},
       {"real_collisions", c.real_collisions},
       {"null_collisions", c.null_collisions()},
       {"scatter_events", c.scatter_events},

@@ -64,11 +64,12 @@ class PlainTracking {
   }
 
   // Radiance Le of `light` reached along dir from prev_p; `light_sampled`: the vertex there
-  // sampled the lights too.
+  // sampled the lights too, picking this one with probability choice_pdf.
   Spectrum<N> light_hit(const Spectrum<N>& Le, const Light& light, const Vec3& prev_p,
-                        const Vec3& dir, bool light_sampled) const {
+                        const Vec3& dir, bool light_sampled, double choice_pdf) const {
     return beta_ * Le *
-           (light_sampled ? power_heuristic(prev_pdf_, light_pdf(light, prev_p, dir)) : 1.0);
+           (light_sampled ? power_heuristic(prev_pdf_, choice_pdf * light_pdf(light, prev_p, dir))
+                          : 1.0);
   }
 
   // Radiance of an emissive surface the path hits (never light-sampled).
@@ -131,9 +132,9 @@ class HeroTracking {
   }
 
   Spectrum<N> light_hit(const Spectrum<N>& Le, const Light& light, const Vec3& prev_p,
-                        const Vec3& dir, bool light_sampled) const {
+                        const Vec3& dir, bool light_sampled, double choice_pdf) const {
     if (!light_sampled) return path_.beta * Le / path_.r_u.average();
-    const Spectrum<N> r_l = path_.r_l * light_pdf(light, prev_p, dir);
+    const Spectrum<N> r_l = path_.r_l * (choice_pdf * light_pdf(light, prev_p, dir));
     return path_.beta * Le / (path_.r_u + r_l).average();
   }
 

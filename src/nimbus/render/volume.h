@@ -80,6 +80,13 @@ MediumEvent<N> real_event(const Collision& c, const MediumPoint<N>& at, Counters
   return ev;
 }
 
+// Adds the lookups made during its lifetime to counters.shadow_lookups.
+struct ShadowLookups {
+  Counters& counters;
+  uint64_t before = counters.tracking.lookups;
+  ~ShadowLookups() { counters.shadow_lookups += counters.tracking.lookups - before; }
+};
+
 }  // namespace volume_detail
 
 // The next real collision over (0, t_max) of the ray (unit direction), for every mode but
@@ -177,6 +184,7 @@ Spectrum<N> transmittance(const Scene& scene, const PathSpectra<N>& ps, const Ra
                           const Spectrum<N>& weight, Rng& rng, Counters& counters) {
   ++counters.shadow_rays;
   if (occluded(scene, ray, t_max, light)) return Spectrum<N>(0.0);
+  const volume_detail::ShadowLookups count{counters};
   auto lookup = [&](double t) {
     return volume_detail::as_sample(medium_at(scene, ps.media, ray.at(t), inside));
   };
@@ -224,6 +232,7 @@ bool transmittance_mis(const Scene& scene, const PathSpectra<N>& ps, const Ray& 
                        Counters& counters) {
   ++counters.shadow_rays;
   if (occluded(scene, ray, t_max, light)) return false;
+  const volume_detail::ShadowLookups count{counters};
   auto lookup = [&](double t) {
     return volume_detail::as_sample(medium_at(scene, ps.media, ray.at(t), inside));
   };

@@ -127,6 +127,7 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor) {
   scene.settings.seed = desc.integrator.seed;
   scene.settings.max_depth = desc.integrator.max_depth;
   scene.settings.sampler = desc.integrator.sampler;
+  scene.settings.light_sampling = desc.integrator.light_sampling;
   scene.settings.tracking = desc.integrator.tracking;
   scene.settings.spectral = desc.spectrum;
   scene.camera = compile_camera(desc.camera, desc.film);

@@ -222,6 +222,8 @@ class Loader {
     if (auto x = o.optional("seed")) d.seed = x->unsigned_integer();
     if (auto x = o.optional("max_depth")) d.max_depth = x->integer(at_least(1));
     if (auto x = o.optional("sampler")) d.sampler = choice_of(*x, "sampler", kSamplerNames);
+    if (auto x = o.optional("light_sampling"))
+      d.light_sampling = choice_of(*x, "light_sampling", kLightSamplingNames);
     TrackingSettings& t = d.tracking;
     if (auto x = o.optional("tracking")) t.mode = choice_of(*x, "tracking", kTrackingModeNames);
     if (auto x = o.optional("absorption"))

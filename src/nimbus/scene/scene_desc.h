@@ -35,6 +35,7 @@ struct IntegratorDesc {
   uint64_t seed = 0;
   int max_depth = 1000;
   RenderSettings::Sampler sampler = RenderSettings::Sampler::ZSobol;
+  RenderSettings::LightSampling light_sampling = RenderSettings::LightSampling::One;
   TrackingSettings tracking;  // its defaults are the scene format's
 };
 

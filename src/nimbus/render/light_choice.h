@@ -1,0 +1,102 @@
+#pragma once
+// One light per vertex for next-event estimation (integrator.light_sampling "one"): light i is
+// picked at p with probability proportional to its unoccluded fluence there, ∫ L dω over the
+// directions it covers, at the path's channels (their average):
+//   environment 4π L, directional E, point I / d², sphere L · 2π (1 − cos θ_max) (4π L inside).
+// A shadow ray costs the same whichever light it aims at, so the light that can bring the most
+// gets the most rays; in a dense medium that is most of a vertex's cost (docs/benchmarks.md,
+// "Light sampling"). The contribution is divided by the probability and MIS takes it into the
+// light technique's pdf, so the estimate stays unbiased for any positive probabilities.
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "nimbus/math/constants.h"
+#include "nimbus/render/light.h"
+#include "nimbus/render/path_spectra.h"
+#include "nimbus/render/scene.h"
+
+namespace nimbus {
+
+// The unoccluded fluence of `light`, whose emission at the path's channels is `emission`, at p.
+template <int N>
+double light_fluence(const Light& light, const Spectrum<N>& emission, const Vec3& p) {
+  const double e = std::max(0.0, emission.average());
+  switch (light.type) {
+    case Light::Type::Environment:
+      return 4 * kPi * e;
+    case Light::Type::Directional:
+      return e;
+    case Light::Type::Point:
+      return e / std::max(dot(p - light.position, p - light.position), 1e-300);
+    case Light::Type::Sphere: {
+      const double d2 = dot(p - light.center, p - light.center), r2 = light.radius * light.radius;
+      if (d2 <= r2) return 4 * kPi * e;
+      const double sin2 = r2 / d2;
+      // 1 − cos θ_max = sin² / (1 + cos), accurate for small spheres far away.
+      return 2 * kPi * e * sin2 / (1 + std::sqrt(1 - sin2));
+    }
+  }
+  return 0;
+}
+
+// The weight with which light j is picked at p: its fluence there, but 0 for a constant
+// environment when another light has fluence at p. BSDF and phase sampling already draw
+// directions in proportion to what multiplies a constant sky's radiance, so MIS gives such
+// samples the sky (a picked light's pdf of 0 gives them weight 1), and the shadow rays go to the
+// lights only light sampling finds: the sun, points, spheres. pbrt-v4 does the same (its uniform
+// infinite light gives no sample where the pdf may be incomplete).
+template <int N>
+double light_choice_weight(const Scene& scene, const PathSpectra<N>& ps, int j, const Vec3& p,
+                           bool skip_environment) {
+  const Light& light = scene.lights[j];
+  if (skip_environment && light.type == Light::Type::Environment) return 0;
+  return light_fluence(light, ps.lights[j], p);
+}
+
+// The sum of the weights, with the choice whether to skip environments.
+template <int N>
+std::pair<double, bool> light_choice_total(const Scene& scene, const PathSpectra<N>& ps,
+                                           const Vec3& p) {
+  const int n = static_cast<int>(scene.lights.size());
+  double total = 0;
+  for (int j = 0; j < n; ++j) total += light_choice_weight(scene, ps, j, p, true);
+  if (total > 0 && std::isfinite(total)) return {total, true};
+  total = 0;
+  for (int j = 0; j < n; ++j) total += light_choice_weight(scene, ps, j, p, false);
+  return {total, false};
+}
+
+// The probability with which choose_light picks light i at p.
+template <int N>
+double light_choice_pdf(const Scene& scene, const PathSpectra<N>& ps, int i, const Vec3& p) {
+  const auto [total, skip] = light_choice_total(scene, ps, p);
+  if (!(total > 0) || !std::isfinite(total)) return 1.0 / double(scene.lights.size());
+  return light_choice_weight(scene, ps, i, p, skip) / total;
+}
+
+// A light picked at p from u uniform in [0, 1), and the probability it was picked with (> 0).
+template <int N>
+std::pair<int, double> choose_light(const Scene& scene, const PathSpectra<N>& ps, const Vec3& p,
+                                    double u) {
+  const int n = static_cast<int>(scene.lights.size());
+  const auto [total, skip] = light_choice_total(scene, ps, p);
+  if (!(total > 0) || !std::isfinite(total)) {
+    const int i = std::min(n - 1, static_cast<int>(u * n));
+    return {i, 1.0 / n};
+  }
+  // The last light with positive weight takes what rounding leaves at the top.
+  double below = 0;
+  int last = 0;
+  for (int j = 0; j < n; ++j) {
+    const double w = light_choice_weight(scene, ps, j, p, skip);
+    if (!(w > 0)) continue;
+    last = j;
+    if (u * total < below + w) return {j, w / total};
+    below += w;
+  }
+  return {last, light_choice_weight(scene, ps, last, p, skip) / total};
+}
+
+}  // namespace nimbus
