@@ -6,6 +6,7 @@
 #include <tbb/task_arena.h>
 
 #include <cmath>
+#include <initializer_list>
 #include <vector>
 
 #include "nimbus/frep/bounds.h"
@@ -176,6 +177,102 @@ TEST(Octree, SpectralBinsBoundMuTAtTheSampledWavelengths) {
     });
   }
   EXPECT_GT(inside_medium, 800);
+}
+
+// Issue 13, item 2: in spectral mode the walk scales each bin's majorant to the channel's own
+// wavelength (channel_majorant_factors). The walked majorants still bound mu_t at every channel
+// on segments of three overlapping media, are never above the bin's, and are tighter than the
+// bin's for these chromatic media; a constant medium's is exact at each wavelength.
+TEST(Octree, SpectralWalkBoundsMuTAtEachChannelsOwnWavelength) {
+  Scene scene = three_media(6);
+  scene.settings.spectral = {SpectralSettings::Mode::Spectral, 8};
+  complete_spectra(scene);
+  build_majorant_octrees(scene);
+  const MajorantOctree& tree = scene.field_octree;
+  Rng rng(5);
+  PathSpectra<8> ps;
+  int checked = 0;
+  double factors = 0;
+  for (int r = 0; r < 300; ++r) {
+    prepare_path_spectra(ps, scene, rng.uniform());
+    for (int c = 0; c < 8; ++c) {
+      EXPECT_GT(ps.ch.majorant_factor[c], 0);
+      EXPECT_LE(ps.ch.majorant_factor[c], 1);
+      factors += ps.ch.majorant_factor[c];
+    }
+    const Vec3 from = point_in(tree.box, rng) * 1.5, to = point_in(tree.box, rng);
+    const Ray ray{from, normalize(to - from)};
+    walk_majorant_segments(scene, ps.ch, ray, 0, 5, -1, [&](const MajorantSegment<8>& s) {
+      for (int k = 0; k < 8; ++k) {
+        const double t = s.t0 + rng.uniform() * (s.t1 - s.t0);
+        const Spectrum<8> mu = medium_at(scene, ps.media, ray.at(t), -1).mu_t();
+        int leaf = 0;
+        descend(tree, ray.at(t), [&](int index, int) { leaf = index; });
+        for (int c = 0; c < 8; ++c) {
+          EXPECT_GE(s.mu_bar[c], mu[c]) << "λ " << ps.ch.wl.lambda[c];
+          EXPECT_LE(s.mu_bar[c], tree.mu_bar(leaf)[ps.ch.bin[c]]) << "λ " << ps.ch.wl.lambda[c];
+        }
+        ++checked;
+      }
+      return true;
+    });
+  }
+  EXPECT_GT(checked, 2000);
+  // Measured 0.981: each factor is the largest over the three media, one of them grey.
+  EXPECT_LT(factors / (300 * 8), 0.99) << "the wavelengths' own majorants should be tighter";
+
+  // One constant medium in a solid: its majorant is sigma_t at each wavelength (within the
+  // octree's round-off margin), not the bin's largest.
+  Scene solid;
+  solid.settings.spectral = {SpectralSettings::Mode::Spectral, 4};
+  Medium m;
+  m.sigma_a = Rgb({0.1, 0.05, 0.2});
+  m.sigma_s = Rgb({8.0, 24.0, 16.0});
+  solid.media.push_back(m);
+  SceneObject obj;
+  obj.tape = compile(*make_shape(QuadricNode{sphere({0, 0, 0}, 1)}));
+  obj.bounds = compute_bounds(obj.tape).box;
+  obj.surface.type = Surface::Type::Dielectric;
+  obj.medium = 0;
+  solid.objects.push_back(std::move(obj));
+  complete_spectra(solid);
+  build_majorant_octrees(solid);
+  PathSpectra<4> ps4;
+  for (int r = 0; r < 50; ++r) {
+    prepare_path_spectra(ps4, solid, rng.uniform());
+    int segments = 0;
+    walk_majorant_segments(solid, ps4.ch, Ray{{0, 0, 0}, {0, 0, 1}}, 0, 1, 0,
+                           [&](const MajorantSegment<4>& s) {
+                             const Spectrum<4> mu = ps4.media[0].sigma_a + ps4.media[0].sigma_s;
+                             for (int c = 0; c < 4; ++c) {
+                               EXPECT_GE(s.mu_bar[c], mu[c]);
+                               EXPECT_NEAR(s.mu_bar[c], mu[c], 1e-9 * mu[c]);
+                             }
+                             ++segments;
+                             return true;
+                           });
+    EXPECT_EQ(segments, 1);
+  }
+}
+
+// A curve's bounds over the octree's bins (SpectralParam::bin_max) hold at every wavelength of
+// the bin, for the curves of an RGB coefficient and of a sampled spectrum.
+TEST(Octree, SpectralParamBinMaxBoundsItsCurveOverEachBin) {
+  SpectralParam rgb = Rgb({8.0, 24.0, 16.0});
+  complete_spectrum(rgb, SpectralRole::Unbounded);
+  const SpectralParam sampled = from_curve(
+      piecewise_linear_spectrum({{400, 4.0}, {480, 1.2}, {540, 0.3}, {620, 1.5}, {700, 3.0}}),
+      SpectralRole::Unbounded);
+  for (const SpectralParam* p : std::initializer_list<const SpectralParam*>{&rgb, &sampled}) {
+    ASSERT_EQ(p->bin_max.size(), size_t(kSpectralBins));
+    for (int b = 0; b < kSpectralBins; ++b) {
+      const auto [lo, hi] = spectral_bin_wavelengths(b);
+      for (int k = 0; k <= 64; ++k) {
+        const double lambda = lo + (hi - lo) * k / 64;
+        EXPECT_GE(p->bin_max[b], (*p->curve)(lambda)) << "bin " << b << " λ " << lambda;
+      }
+    }
+  }
 }
 
 struct Walked {

@@ -160,7 +160,10 @@ void walk_majorant_segments(const S& scene, const Channels<N>& ch, const Ray& ra
   } else if (!clip_ray(tree.box, ray, t0, t1) || !(t1 > t0)) {
     return;
   }
-  const double scale = tree.majorant_scale;
+  // The tree's majorant scale times each channel's factor from its bin to its own wavelength
+  // (exactly the scale in rgb mode, where the factors are 1).
+  std::array<double, N> scale;
+  for (int c = 0; c < N; ++c) scale[c] = tree.majorant_scale * ch.majorant_factor[c];
   MajorantSegment<N> pending{0, 0, Spectrum<N>(0.0), Spectrum<N>(0.0)};
   bool has_pending = false;
   int span = 0;          // the first span that may overlap the current leaf
@@ -180,7 +183,7 @@ void walk_majorant_segments(const S& scene, const Channels<N>& ch, const Ray& ra
     const double* lo = tree.mu_c(node);
     Spectrum<N> mu_bar, mu_c;
     for (int c = 0; c < N; ++c) {
-      mu_bar[c] = hi[ch.bin[c]] * scale;
+      mu_bar[c] = hi[ch.bin[c]] * scale[c];
       mu_c[c] = lo[ch.bin[c]];
     }
     if (tree.nodes[node].filled) return emit(a, b, mu_bar, mu_c);

@@ -9,7 +9,6 @@
 #include "nimbus/math/rng.h"
 #include "nimbus/media/medium_field.h"
 #include "nimbus/spectral/channels.h"
-#include "nimbus/spectral/wavelengths.h"
 
 namespace nimbus {
 namespace {
@@ -34,9 +33,7 @@ std::vector<std::vector<double>> sigma_t_bins(std::span<const Medium> media, boo
         v[b] = v[bins + b] = m.sigma_a.rgb[b] + m.sigma_s.rgb[b];
         continue;
       }
-      const double lo = sample_visible_wavelength(double(b) / bins);
-      const double hi =
-          b + 1 == bins ? kLambdaMax : sample_visible_wavelength(double(b + 1) / bins);
+      const auto [lo, hi] = spectral_bin_wavelengths(b);  // bins == kSpectralBins here
       const auto [a_lo, a_hi] = m.sigma_a.curve->range(lo, hi);
       const auto [s_lo, s_hi] = m.sigma_s.curve->range(lo, hi);
       v[b] = a_hi + s_hi;

@@ -26,6 +26,31 @@ struct PathSpectra {
   std::vector<Spectrum<N>> lights;           // each light's emission, indexed as scene.lights
 };
 
+// The octree bounds mu_t = density · sigma_t per wavelength bin, with each medium's sigma_t at its
+// upper bound over the bin (SpectralParam::bin_max); a channel's own mu_t is bounded by that
+// majorant times max over media of sigma_t(λ) / (its bound over λ's bin), which is 1 at most.
+// Free paths and shadow rays then take collisions at the rate of each channel's own wavelength,
+// not at the highest over its bin, which for a chromatic medium is far above it where sigma_t
+// changes fast with λ (scenes/bench/chromatic_cloud.json, 4 wavelengths: 24.2 density lookups
+// per sample before, 19.4 after, rgb mode 20.5). Stays 1 where a bound is unknown.
+template <int N>
+void channel_majorant_factors(PathSpectra<N>& ps, const Scene& scene) {
+  for (int i = 0; i < N; ++i) {
+    double f = 0;
+    for (size_t m = 0; m < scene.media.size() && f < 1; ++m) {
+      const Medium& med = scene.media[m];
+      if (med.sigma_a.bin_max.empty() || med.sigma_s.bin_max.empty()) {
+        f = 1;
+        break;
+      }
+      const double bound = med.sigma_a.bin_max[ps.ch.bin[i]] + med.sigma_s.bin_max[ps.ch.bin[i]];
+      if (bound > 0) f = std::max(f, (ps.media[m].sigma_a[i] + ps.media[m].sigma_s[i]) / bound);
+    }
+    // A medium without extinction in the bin leaves its majorant 0 there anyway.
+    ps.ch.majorant_factor[i] = f > 0 ? std::min(f, 1.0) : 1.0;
+  }
+}
+
 // Sets up ps for a path of `scene`: in rgb mode the RGB channels (u unused); in spectral mode
 // N wavelengths from the uniform number u. Reuses ps's storage.
 template <int N>
@@ -51,6 +76,7 @@ void prepare_path_spectra(PathSpectra<N>& ps, const Scene& scene, double u) {
       c.lambda = ps.ch.wl.lambda;
     }
   }
+  if (ps.ch.spectral) channel_majorant_factors(ps, scene);
   ps.lights.resize(scene.lights.size());
   for (size_t l = 0; l < scene.lights.size(); ++l)
     ps.lights[l] = evaluate(scene.lights[l].emission, ps.ch);

@@ -5,6 +5,7 @@
 // Spectrum<N> values in either mode.
 
 #include <array>
+#include <utility>
 
 #include "nimbus/spectral/spectral_param.h"
 #include "nimbus/spectral/spectrum.h"
@@ -16,11 +17,25 @@ namespace nimbus {
 // wavelength pdf, so a channel drawn from stratified number u lies in bin ⌊u · kSpectralBins⌋.
 inline constexpr int kSpectralBins = 16;
 
+// Bin b's wavelength interval [lo, hi] (nm), over which the octree bounds each medium's sigma_t.
+inline std::pair<double, double> spectral_bin_wavelengths(int b) {
+  return {sample_visible_wavelength(double(b) / kSpectralBins),
+          b + 1 == kSpectralBins ? kLambdaMax
+                                 : sample_visible_wavelength(double(b + 1) / kSpectralBins)};
+}
+
 template <int N>
 struct Channels {
   bool spectral = false;
   SampledWavelengths<N> wl;  // spectral mode
   std::array<int, N> bin{};  // the majorant octree's bin holding each channel
+  // Multiplies the bin's majorant to bound mu_t at the channel's own wavelength
+  // (channel_majorant_factors in render/path_spectra.h); 1 in rgb mode.
+  std::array<double, N> majorant_factor = [] {
+    std::array<double, N> f;
+    f.fill(1.0);
+    return f;
+  }();
 };
 
 // A colour input at the path's channels.

@@ -2,10 +2,28 @@
 
 #include <algorithm>
 
+#include "nimbus/spectral/channels.h"
+
 namespace nimbus {
+namespace {
+
+void fill_bin_max(SpectralParam& p) {
+  p.bin_max.resize(kSpectralBins);
+  for (int b = 0; b < kSpectralBins; ++b) {
+    const auto [lo, hi] = spectral_bin_wavelengths(b);
+    p.bin_max[b] = p.curve->range(lo, hi).second;
+  }
+}
+
+}  // namespace
 
 void complete_spectrum(SpectralParam& p, SpectralRole role) {
-  if (p.curve) return;
+  // bin_max is refilled even for a curve that has one: compile_scene calls this just before it
+  // builds the octrees from the curves, so the two cannot disagree after an edit of the curve.
+  if (p.curve) {
+    fill_bin_max(p);
+    return;
+  }
   switch (role) {
     case SpectralRole::Albedo:
       p.curve = rgb_albedo_spectrum(p.rgb);
@@ -17,6 +35,7 @@ void complete_spectrum(SpectralParam& p, SpectralRole role) {
       p.curve = rgb_illuminant_spectrum(p.rgb);
       break;
   }
+  fill_bin_max(p);
 }
 
 SpectralParam from_curve(SpectralCurve curve, SpectralRole role) {
@@ -28,6 +47,7 @@ SpectralParam from_curve(SpectralCurve curve, SpectralRole role) {
     if (role == SpectralRole::Albedo) p.rgb[c] = std::min(p.rgb[c], 1.0);
   }
   p.curve = std::move(curve);
+  fill_bin_max(p);
   return p;
 }
 

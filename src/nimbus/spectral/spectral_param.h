@@ -5,6 +5,7 @@
 // depending on what the value means (its role).
 
 #include <optional>
+#include <vector>
 
 #include "nimbus/spectral/spectral_curve.h"
 #include "nimbus/spectral/spectrum.h"
@@ -20,12 +21,16 @@ enum class SpectralRole {
 struct SpectralParam {
   Rgb rgb{0.0};
   std::optional<SpectralCurve> curve;  // absent: upsample rgb (complete_spectrum)
+  // The curve's upper bound over each wavelength bin of the majorant octree (channels.h), as the
+  // octree takes it (SpectralCurve::range); empty where not known. complete_spectrum and
+  // from_curve fill it: a path then scales its bin's majorant to its own wavelength.
+  std::vector<double> bin_max;
 
   SpectralParam() = default;
   SpectralParam(const Rgb& value) : rgb(value) {}  // NOLINT: scenes built in code give RGB
 };
 
-// Gives p its curve from its RGB if it has none.
+// Gives p its curve from its RGB if it has none, and fills its bin_max from its curve.
 void complete_spectrum(SpectralParam& p, SpectralRole role);
 
 // A curve given in the scene file, with the RGB that rgb mode uses for it: its reflectance
