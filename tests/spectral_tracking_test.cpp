@@ -277,6 +277,34 @@ TEST(HeroTracking, ShadowRayTransmittance) {
   }
 }
 
+// Roulette on the contribution's share (a weight per channel) keeps every channel unbiased,
+// whatever the weights, and stops the walk sooner when the weight sits on the densest channel.
+TEST(HeroTracking, ShadowRayRouletteOnTheContribution) {
+  Profile p;
+  auto lookup = [&](double t) { return p.at(t); };
+  const Rgb T_ref = p.transmittance();
+  int dense = 0;
+  for (int c = 1; c < 3; ++c)
+    if (T_ref[c] < T_ref[dense]) dense = c;
+  Rgb weight(1e-3);
+  weight[dense] = 1;
+  Rng rng(13);
+  TrackingCounters plain, weighted;
+  std::array<test::MeanVar, 3> T;
+  for (int i = 0; i < kWalks; ++i) {
+    MisPath<3> path;
+    const bool alive = hero_ratio_tracking<3>(lookup, kT0, kT1, p.majorant() * 1.05, i % 3, path,
+                                              rng, weighted, &weight);
+    const Rgb v = alive ? path.beta / path.r_l.average() : Rgb(0.0);
+    for (int c = 0; c < 3; ++c) T[c].add(v[c]);
+    MisPath<3> other;
+    hero_ratio_tracking<3>(lookup, kT0, kT1, p.majorant() * 1.05, i % 3, other, rng, plain);
+  }
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(T[c].mean, T_ref[c], 4 * T[c].std_error()) << "channel " << c;
+  EXPECT_LT(weighted.lookups, plain.lookups);
+}
+
 // Issue 17: channel 1's majorant fails everywhere (half its bound), channels 0 and 2 bound; issue
 // 13: every channel's majorant fails (half its bound). Where a channel's majorant fails its
 // technique samples null events in proportion to |mu_n| (failing_share), and the majorant is

@@ -118,8 +118,8 @@ class HeroTracking {
                   int light, int inside, const LightSample& ls, const Spectrum<N>& fLi, Pdf&& f_pdf,
                   Rng& rng, Counters& counters, Spectrum<N>& out) const {
     MisPath<N> s;
-    if (!transmittance_mis(scene, ps, shadow, t_max, light, inside, hero_, boost_, s, rng,
-                           counters))
+    if (!transmittance_mis(scene, ps, shadow, t_max, light, inside, hero_, boost_, path_.beta * fLi,
+                           s, rng, counters))
       return false;
     const Spectrum<N>& r_p = path_.r_u;
     if (ls.delta) {

@@ -225,11 +225,12 @@ Spectrum<N> transmittance(const Scene& scene, const PathSpectra<N>& ps, const Ra
 }
 
 // spectral-mis: the shadow ray's T_ray, r_u and r_l (in `path`, which starts at 1), by hero ratio
-// tracking. False if a surface blocks the way or T_ray became 0.
+// tracking, with roulette on the share of `weight` (what multiplies the transmittance in the
+// contribution) that it carries. False if a surface blocks the way or T_ray became 0.
 template <int N>
 bool transmittance_mis(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray, double t_max,
-                       int light, int inside, int hero, double boost, MisPath<N>& path, Rng& rng,
-                       Counters& counters) {
+                       int light, int inside, int hero, double boost, const Spectrum<N>& weight,
+                       MisPath<N>& path, Rng& rng, Counters& counters) {
   ++counters.shadow_rays;
   if (occluded(scene, ray, t_max, light)) return false;
   const volume_detail::ShadowLookups count{counters};
@@ -240,7 +241,7 @@ bool transmittance_mis(const Scene& scene, const PathSpectra<N>& ps, const Ray& 
   walk_majorant_segments(scene, ps.ch, ray, 0, t_max, inside, [&](const MajorantSegment<N>& seg) {
     ++counters.majorant_segments;
     reaches = hero_ratio_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_bar * boost, hero, path, rng,
-                                     counters.tracking);
+                                     counters.tracking, &weight);
     return reaches;
   });
   return reaches;

@@ -138,10 +138,13 @@ Collision hero_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>
 // tentative collision):  T_ray *= T_maj mu_n / pdf,  r_l *= T_maj mu_maj / pdf,
 // r_u *= T_maj max(0, mu_n) / pdf, and at the end all three *= T_maj / T_maj[h]. The transmittance
 // is T_ray / avg(r_u + r_l) once multiplied by the vertex pdfs. Russian roulette (q = 3/4) where
-// |that estimate| falls below 0.05. Returns false once T_ray is 0.
+// |that estimate| falls below 0.05: its largest channel, or with a `weight` (what multiplies it
+// in the contribution, per channel) its share Σ|w T| / Σ|w|, so that a channel carrying little
+// of the contribution does not keep the walk going alone. Returns false once T_ray is 0.
 template <int N, class Lookup>
 bool hero_ratio_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>& mu_maj, int h,
-                         MisPath<N>& path, Rng& rng, TrackingCounters& counters) {
+                         MisPath<N>& path, Rng& rng, TrackingCounters& counters,
+                         const Spectrum<N>* weight = nullptr) {
   double t_prev = t0;        // the last tentative collision
   Spectrum<N> maj = mu_maj;  // raised where it fails (raise_majorants)
   const bool reached = track_tentative_collisions(
@@ -155,7 +158,16 @@ bool hero_ratio_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N
         path.r_l *= T_maj * maj / pdf;
         path.r_u *= T_maj * abs(mu_n) * failing_share(m, mu_n, maj) / pdf;
         const Spectrum<N> T = path.beta / (path.r_u + path.r_l).average();
-        if (T.max_abs() < 0.05) {  // |T|: a majorant that fails makes it signed
+        double share = T.max_abs();  // |T|: a majorant that fails makes it signed
+        if (weight) {
+          double wT = 0, w = 0;
+          for (int c = 0; c < N; ++c) {
+            wT += std::abs((*weight)[c] * T[c]);
+            w += std::abs((*weight)[c]);
+          }
+          if (w > 0) share = wT / w;
+        }
+        if (share < 0.05) {
           if (rng.uniform() < 0.75)
             path.beta = Spectrum<N>(0.0);
           else
