@@ -6,7 +6,9 @@
 // A shadow ray costs the same whichever light it aims at, so the light that can bring the most
 // gets the most rays; in a dense medium that is most of a vertex's cost (docs/benchmarks.md,
 // "Light sampling"). The contribution is divided by the probability and MIS takes it into the
-// light technique's pdf, so the estimate stays unbiased for any positive probabilities.
+// light technique's pdf. That stays unbiased: a light only light sampling can reach (directional,
+// point) has a positive probability wherever it emits, and a light given probability 0 (a sky,
+// light_choice_weight) is found by phase and BSDF sampling with MIS weight 1.
 
 #include <algorithm>
 #include <cmath>
