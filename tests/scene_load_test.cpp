@@ -152,6 +152,10 @@ std::vector<BadScene> bad_scenes() {
        with_camera(R"("integrator": {"sampler": "sobol"})"),
        {},
        R"(scene.json: /integrator/sampler: unknown sampler "sobol" (expected one of: zsobol, independent))"},
+      {"unknown light sampling",
+       with_camera(R"("integrator": {"light_sampling": "two"})"),
+       {},
+       R"(scene.json: /integrator/light_sampling: unknown light_sampling "two" (expected one of: all, one))"},
       {"unknown tracking",
        with_camera(R"("integrator": {"tracking": "ratio"})"),
        {},
@@ -481,6 +485,7 @@ TEST(SceneLoad, ExampleLoads) {
   EXPECT_EQ(s.camera.fov, 35);
   EXPECT_EQ(s.integrator.spp, 64);
   EXPECT_EQ(s.integrator.sampler, RenderSettings::Sampler::ZSobol);
+  EXPECT_EQ(s.integrator.light_sampling, RenderSettings::LightSampling::One);
   EXPECT_EQ(s.integrator.tracking.mode, TrackingSettings::Mode::SpectralMis);
 
   ASSERT_EQ(s.lights.size(), 4u);
@@ -676,9 +681,11 @@ TEST(SceneLoad, OverridesReplaceAndCreateValues) {
            {"integrator.spp=256", "camera.from=[1, 2, 3]", "camera.type=orthographic",
             "integrator.majorant.scale=1.5", "film.width=100", "film.width=200",
             "lights.0.radiance=[0.1, 0.2, 0.3]", R"(integrator.tracking="spectral-mis")",
-            "integrator.octree={\"depth\": 3}", R"(integrator.sampler="independent")"});
+            "integrator.octree={\"depth\": 3}", R"(integrator.sampler="independent")",
+            R"(integrator.light_sampling="all")"});
   EXPECT_EQ(s.integrator.spp, 256);
   EXPECT_EQ(s.integrator.sampler, RenderSettings::Sampler::Independent);
+  EXPECT_EQ(s.integrator.light_sampling, RenderSettings::LightSampling::All);
   EXPECT_EQ(s.camera.from, (Vec3{1, 2, 3}));
   EXPECT_EQ(s.camera.type, CameraDesc::Type::Orthographic);
   EXPECT_EQ(s.integrator.tracking.majorant_scale, 1.5);
