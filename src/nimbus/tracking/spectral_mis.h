@@ -32,6 +32,7 @@
 #include "nimbus/tracking/delta_tracking.h"
 #include "nimbus/tracking/free_flight.h"
 #include "nimbus/tracking/medium_sample.h"
+#include "nimbus/tracking/transmittance.h"
 
 namespace nimbus {
 
@@ -158,16 +159,8 @@ bool hero_ratio_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N
         path.r_l *= T_maj * maj / pdf;
         path.r_u *= T_maj * abs(mu_n) * failing_share(m, mu_n, maj) / pdf;
         const Spectrum<N> T = path.beta / (path.r_u + path.r_l).average();
-        double share = T.max_abs();  // |T|: a majorant that fails makes it signed
-        if (weight) {
-          double wT = 0, w = 0;
-          for (int c = 0; c < N; ++c) {
-            wT += std::abs((*weight)[c] * T[c]);
-            w += std::abs((*weight)[c]);
-          }
-          if (w > 0) share = wT / w;
-        }
-        if (share < 0.05) {
+        // |T|: a majorant that fails makes it signed.
+        if (contribution_share(T, weight) < 0.05) {
           if (rng.uniform() < 0.75)
             path.beta = Spectrum<N>(0.0);
           else

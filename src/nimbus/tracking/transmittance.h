@@ -24,16 +24,12 @@ namespace nimbus {
 // Below this, a transmittance estimate plays Russian roulette (transmittance_roulette).
 inline constexpr double kRouletteThreshold = 0.1;
 
-// Russian roulette on a transmittance estimate T: once its share m of the contribution it can
-// still make falls below kRouletteThreshold, T survives with probability q = m /
-// kRouletteThreshold and is divided by q, else it becomes 0. E[T] is unchanged, and a shadow
-// ray through a dense medium stops after a few more collisions instead of walking to its end.
-// m is max|T| without a weight; with one (what multiplies T in the contribution: the path's
-// throughput times the scattering function and the light, per channel) it is
-// Σ|w T| / Σ|w|, so a channel that carries little of the contribution cannot keep the walk
-// going alone (issue 13). Returns false when T was set to 0.
+// The share of the contribution that a transmittance estimate T still carries: max|T| without a
+// weight; with one (what multiplies T in the contribution: the path's throughput times the
+// scattering function and the light, per channel) Σ|w T| / Σ|w|, so that a channel carrying
+// little of the contribution cannot keep a walk going alone (issue 13).
 template <int N>
-bool transmittance_roulette(Spectrum<N>& T, Rng& rng, const Spectrum<N>* weight = nullptr) {
+double contribution_share(const Spectrum<N>& T, const Spectrum<N>* weight) {
   double m = T.max_abs();
   if (weight) {
     double wT = 0, w = 0;
@@ -43,6 +39,17 @@ bool transmittance_roulette(Spectrum<N>& T, Rng& rng, const Spectrum<N>* weight 
     }
     if (w > 0) m = wT / w;
   }
+  return m;
+}
+
+// Russian roulette on a transmittance estimate T: once its share m of the contribution it can
+// still make falls below kRouletteThreshold, T survives with probability q = m /
+// kRouletteThreshold and is divided by q, else it becomes 0. E[T] is unchanged, and a shadow
+// ray through a dense medium stops after a few more collisions instead of walking to its end.
+// m is contribution_share(T, weight). Returns false when T was set to 0.
+template <int N>
+bool transmittance_roulette(Spectrum<N>& T, Rng& rng, const Spectrum<N>* weight = nullptr) {
+  const double m = contribution_share(T, weight);
   if (m >= kRouletteThreshold) return true;
   const double q = m / kRouletteThreshold;
   if (rng.uniform() < q) {
