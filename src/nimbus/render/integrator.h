@@ -150,7 +150,7 @@ template <int N, class Policy>
 Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, PathSampler& sampler,
                        Counters& counters, Policy& policy) {
   Rng& rng = sampler.rng();
-  const int lights = light_slots(scene);
+  const int slots = light_slots(scene);  // per bounce, in the sampler's dimensions
   Spectrum<N> L(0.0);
   int inside = solid_containing(scene, ray.o);  // the solid (dielectric) the path is in, or -1
   // The last vertex sampled the lights (next-event estimation), so a light the path hits next
@@ -159,7 +159,7 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
   Vec3 prev_p = ray.o;  // where the current direction was sampled
 
   for (int depth = 0;; ++depth) {
-    const uint32_t bounce = SampleDims::bounce(depth, lights);
+    const uint32_t bounce = SampleDims::bounce(depth, slots);
     // Roulette's number is drawn only when roulette plays (the independent sampler's order).
     const auto roulette_u = [&] { return sampler.get1d(bounce + SampleDims::kRoulette); };
     ++counters.surface_rays;
