@@ -64,26 +64,60 @@ void for_each_medium_at(const S& scene, const Vec3& x, int inside, F&& f) {
   }
 }
 
+namespace medium_field_detail {
+
+// Adds a medium of coefficients c at density `density` at x to the sums mu_a, mu_s and
+// mu_a_Le = Σ mu_a,i L_e,i.
+template <int N>
+void add_medium(const MediumCoefficients<N>& c, double density, const Vec3& x, Spectrum<N>& mu_a,
+                Spectrum<N>& mu_s, Spectrum<N>& mu_a_Le) {
+  const Spectrum<N> a = c.sigma_a * density;
+  mu_a += a;
+  mu_s += c.sigma_s * density;
+  if (c.emission_grid)
+    mu_a_Le += a * temperature_emission_at<N>(*c.emission_grid, x, c.spectral, c.lambda);
+  else
+    mu_a_Le += a * c.emission;
+}
+
+}  // namespace medium_field_detail
+
 // The coefficients at x seen from `inside`, with each medium's coefficients at the path's
-// channels in `coefficients` (indexed as scene.media).
+// channels in `coefficients` (indexed as scene.media), written into m. Only the first m.media
+// entries of m's per-medium arrays are set: filling a point in place, rather than returning a
+// fresh one, spares a tracker that looks up many points the copy and clearing of those arrays.
+template <int N, MediumHolders S>
+void medium_at(const S& scene, const std::vector<MediumCoefficients<N>>& coefficients,
+               const Vec3& x, int inside, MediumPoint<N>& m) {
+  m.mu_a = m.mu_s = m.mu_a_Le = Spectrum<N>(0.0);
+  m.media = 0;
+  for_each_medium_at(scene, x, inside, [&](int medium, double density) {
+    const MediumCoefficients<N>& c = coefficients[medium];
+    medium_field_detail::add_medium(c, density, x, m.mu_a, m.mu_s, m.mu_a_Le);
+    m.g[m.media] = scene.media[medium].g;
+    m.mu_s_i[m.media] = c.sigma_s * density;
+    ++m.media;
+  });
+}
+
 template <int N, MediumHolders S>
 MediumPoint<N> medium_at(const S& scene, const std::vector<MediumCoefficients<N>>& coefficients,
                          const Vec3& x, int inside) {
   MediumPoint<N> m;
-  for_each_medium_at(scene, x, inside, [&](int medium, double density) {
-    const MediumCoefficients<N>& c = coefficients[medium];
-    const Spectrum<N> mu_a = c.sigma_a * density, mu_s = c.sigma_s * density;
-    m.mu_a += mu_a;
-    m.mu_s += mu_s;
-    if (c.emission_grid)
-      m.mu_a_Le += mu_a * temperature_emission_at<N>(*c.emission_grid, x, c.spectral, c.lambda);
-    else
-      m.mu_a_Le += mu_a * c.emission;
-    m.g[m.media] = scene.media[medium].g;
-    m.mu_s_i[m.media] = mu_s;
-    ++m.media;
-  });
+  medium_at(scene, coefficients, x, inside, m);
   return m;
+}
+
+// The sums mu_a, mu_s and mu_a_Le at x seen from `inside`, without the phase functions: all that
+// a transmittance estimate needs.
+template <int N, MediumHolders S>
+void medium_sums_at(const S& scene, const std::vector<MediumCoefficients<N>>& coefficients,
+                    const Vec3& x, int inside, Spectrum<N>& mu_a, Spectrum<N>& mu_s,
+                    Spectrum<N>& mu_a_Le) {
+  mu_a = mu_s = mu_a_Le = Spectrum<N>(0.0);
+  for_each_medium_at(scene, x, inside, [&](int medium, double density) {
+    medium_field_detail::add_medium(coefficients[medium], density, x, mu_a, mu_s, mu_a_Le);
+  });
 }
 
 // A stretch of a ray with a majorant mu_bar and a minorant mu_c of mu_t there, per channel.

@@ -42,10 +42,28 @@ inline constexpr double kBoostOnRaise = 2;
 
 namespace volume_detail {
 
+// L_e = mu_a_Le / mu_a where mu_a > 0, else 0.
+template <int N>
+Spectrum<N> emission(const Spectrum<N>& mu_a, const Spectrum<N>& mu_a_Le) {
+  Spectrum<N> L_e(0.0);
+  for (int c = 0; c < N; ++c)
+    if (mu_a_Le[c] != 0 && mu_a[c] > 0) L_e[c] = mu_a_Le[c] / mu_a[c];
+  return L_e;
+}
+
 template <int N>
 MediumSample<N> as_sample(const MediumPoint<N>& m) {
-  MediumSample<N> s{m.mu_a, m.mu_s, Spectrum<N>(0.0)};
-  for (int c = 0; c < N; ++c) s.L_e[c] = m.mu_a[c] > 0 ? m.mu_a_Le[c] / m.mu_a[c] : 0.0;
+  return {m.mu_a, m.mu_s, emission(m.mu_a, m.mu_a_Le)};
+}
+
+// The coefficients at a point of a shadow ray: no phase functions.
+template <int N>
+MediumSample<N> shadow_sample(const Scene& scene, const PathSpectra<N>& ps, const Vec3& x,
+                              int inside) {
+  MediumSample<N> s;
+  Spectrum<N> mu_a_Le;
+  medium_sums_at(scene, ps.media, x, inside, s.mu_a, s.mu_s, mu_a_Le);
+  s.L_e = emission(s.mu_a, mu_a_Le);
   return s;
 }
 
@@ -59,7 +77,7 @@ struct RayLookup {
   int inside;
   MediumPoint<N> last;
   MediumSample<N> operator()(double t) {
-    last = medium_at(scene, ps.media, ray.at(t), inside);
+    medium_at(scene, ps.media, ray.at(t), inside, last);
     return as_sample(last);
   }
 };
@@ -186,7 +204,7 @@ Spectrum<N> transmittance(const Scene& scene, const PathSpectra<N>& ps, const Ra
   if (occluded(scene, ray, t_max, light)) return Spectrum<N>(0.0);
   const volume_detail::ShadowLookups count{counters};
   auto lookup = [&](double t) {
-    return volume_detail::as_sample(medium_at(scene, ps.media, ray.at(t), inside));
+    return volume_detail::shadow_sample(scene, ps, ray.at(t), inside);
   };
   using Estimator = TrackingSettings::Transmittance;
   const Estimator estimator = scene.settings.tracking.transmittance;
@@ -235,7 +253,7 @@ bool transmittance_mis(const Scene& scene, const PathSpectra<N>& ps, const Ray& 
   if (occluded(scene, ray, t_max, light)) return false;
   const volume_detail::ShadowLookups count{counters};
   auto lookup = [&](double t) {
-    return volume_detail::as_sample(medium_at(scene, ps.media, ray.at(t), inside));
+    return volume_detail::shadow_sample(scene, ps, ray.at(t), inside);
   };
   bool reaches = true;
   walk_majorant_segments(scene, ps.ch, ray, 0, t_max, inside, [&](const MajorantSegment<N>& seg) {
