@@ -81,6 +81,21 @@ TEST(CloudDensity, RangeIsTightAtTheEnds) {
   EXPECT_EQ(cloud_density_range(0.01, 0.1, p).first, 0.0);
 }
 
+TEST(CloudDensity, ExactlyOneFromTheEdgeOnAndBelowOneJustInside) {
+  // d = 1 wherever F >= edge (cloud_density returns it without the noise); just below the edge
+  // the noise still erodes some points, so that shortcut reaches no further.
+  const CloudParams p{.octaves = 4, .frequency = 3, .amplitude = 0.6, .seed = 5, .edge = 0.4};
+  const CloudNoise cloud = make_cloud_noise(p);
+  Rng rng(11);
+  int eroded_below = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3 x = random_point(rng, 2);
+    EXPECT_EQ(cloud_density(cloud, x, p.edge + 2 * rng.uniform()), 1.0);
+    eroded_below += cloud_density(cloud, x, 0.97 * p.edge) < 1;
+  }
+  EXPECT_GT(eroded_below, 1000);
+}
+
 TEST(CloudDensity, ErodedEdgeHasHolesAndDenseCore) {
   // On the unit sphere with F = 1 − |x|², amplitude 0.6: between radii 0.75 and 0.95 some
   // points are empty and some are not (billowy edge with holes); near the centre all are dense.

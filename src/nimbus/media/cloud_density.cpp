@@ -35,6 +35,8 @@ double cloud_density(const CloudNoise& cloud, const Vec3& x, double F) {
   const CloudParams& p = cloud.params;
   const double s = profile(F, p.edge);
   if (s <= 0) return 0;
+  // In the core (F >= edge) d = (1 − E)/(1 − E) = 1 exactly, whatever the noise: skip it.
+  if (s >= 1) return 1;
   const Vec3 q = p.frequency * x;
   const Vec3 warp{fbm(cloud.noise, q + kWarpOffset[0], kCloudWarpOctaves),
                   fbm(cloud.noise, q + kWarpOffset[1], kCloudWarpOctaves),
