@@ -144,13 +144,19 @@ TEST(Octree, ConservativeBoundsContainMuTAtRandomPoints) {
   EXPECT_GT(deep, 50) << "the tree should refine where the media vary";
 }
 
-// In spectral mode the tree holds bounds per wavelength bin; every wavelength a path can draw
-// is bounded by its bin's, at every level (the minorants where the walks go).
-TEST(Octree, SpectralBinsBoundMuTAtTheSampledWavelengths) {
+// three_media(6) in spectral mode with 8 wavelengths, its octrees built per wavelength bin.
+Scene three_media_spectral_8() {
   Scene scene = three_media(6);
   scene.settings.spectral = {SpectralSettings::Mode::Spectral, 8};
   complete_spectra(scene);
   build_majorant_octrees(scene);
+  return scene;
+}
+
+// In spectral mode the tree holds bounds per wavelength bin; every wavelength a path can draw
+// is bounded by its bin's, at every level (the minorants where the walks go).
+TEST(Octree, SpectralBinsBoundMuTAtTheSampledWavelengths) {
+  const Scene scene = three_media_spectral_8();
   const MajorantOctree& tree = scene.field_octree;
   ASSERT_EQ(tree.bins, kSpectralBins);
   ASSERT_GE(tree.depth, 4);
@@ -184,10 +190,7 @@ TEST(Octree, SpectralBinsBoundMuTAtTheSampledWavelengths) {
 // on segments of three overlapping media, are never above the bin's, and are tighter than the
 // bin's for these chromatic media; a constant medium's is exact at each wavelength.
 TEST(Octree, SpectralWalkBoundsMuTAtEachChannelsOwnWavelength) {
-  Scene scene = three_media(6);
-  scene.settings.spectral = {SpectralSettings::Mode::Spectral, 8};
-  complete_spectra(scene);
-  build_majorant_octrees(scene);
+  const Scene scene = three_media_spectral_8();
   const MajorantOctree& tree = scene.field_octree;
   Rng rng(5);
   PathSpectra<8> ps;

@@ -22,6 +22,7 @@
 #include "nimbus/math/rng.h"
 #include "nimbus/tracking/decomposition_tracking.h"
 #include "nimbus/tracking/spectral_mis.h"
+#include "support/contribution_weight.h"
 #include "support/stats.h"
 
 namespace nimbus {
@@ -283,11 +284,7 @@ TEST(HeroTracking, ShadowRayRouletteOnTheContribution) {
   Profile p;
   auto lookup = [&](double t) { return p.at(t); };
   const Rgb T_ref = p.transmittance();
-  int dense = 0;
-  for (int c = 1; c < 3; ++c)
-    if (T_ref[c] < T_ref[dense]) dense = c;
-  Rgb weight(1e-3);
-  weight[dense] = 1;
+  const Rgb weight = test::weight_on_densest_channel(T_ref);
   Rng rng(13);
   TrackingCounters plain, weighted;
   std::array<test::MeanVar, 3> T;

@@ -13,6 +13,7 @@
 #include "nimbus/tracking/medium_sample.h"
 #include "nimbus/tracking/ray_marching_transmittance.h"
 #include "nimbus/tracking/transmittance.h"
+#include "support/contribution_weight.h"
 #include "support/stats.h"
 
 namespace nimbus {
@@ -126,11 +127,7 @@ TEST(RatioTracking, MatchesAnalyticTransmittance) {
 TEST(RatioTracking, RouletteOnTheContributionIsUnbiasedAndStopsSooner) {
   for (const Profile& p : profiles()) {
     const Rgb T = p.transmittance();
-    int dense = 0;
-    for (int c = 1; c < 3; ++c)
-      if (T[c] < T[dense]) dense = c;
-    Rgb weight(1e-3);
-    weight[dense] = 1;
+    const Rgb weight = test::weight_on_densest_channel(T);
     Rng rng(104);
     TrackingCounters plain, weighted;
     const auto z = z_scores(
