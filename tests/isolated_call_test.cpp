@@ -5,12 +5,22 @@
 #include "nimbus/media/isolated_call.h"
 
 #include <gtest/gtest.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdlib>
+#include <filesystem>
+#include <mutex>
 #include <new>
+#include <set>
 #include <stdexcept>
+#include <string>
+#include <thread>
 #include <vector>
 
 #include "support/sanitizer.h"
@@ -88,6 +98,86 @@ TEST(IsolatedCall, AnExceptionOtherThanBadAllocIsACrash) {
       call_isolated([]() -> std::string { throw std::runtime_error("no"); }, kLimits);
   EXPECT_EQ(r.status, Status::Crashed);
   EXPECT_EQ(r.signal, 0);
+}
+
+// The threads of process `pid`, from /proc.
+int thread_count(pid_t pid) {
+  int n = 0;
+  for ([[maybe_unused]] const auto& entry :
+       std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/task"))
+    ++n;
+  return n;
+}
+
+// Starts oneTBB's workers: a parallel loop that waits (up to a second) until as many threads
+// as oneTBB uses have taken part. Returns how many did.
+int start_tbb_workers() {
+  std::mutex m;
+  std::set<std::thread::id> seen;
+  const std::size_t want = std::size_t(tbb::info::default_concurrency());
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+  tbb::parallel_for(0, 1000, [&](int) {
+    {
+      const std::lock_guard<std::mutex> lock(m);
+      seen.insert(std::this_thread::get_id());
+      if (seen.size() >= want) return;
+    }
+    if (std::chrono::steady_clock::now() < until)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  });
+  return int(seen.size());
+}
+
+// A lock held by one of oneTBB's workers when fork() copies the process stays held in the child
+// for ever, and OpenVDB's own code in the child runs parallel loops: so no worker may exist then.
+// The child sees its parent as it is during the call. (On a machine where oneTBB runs one thread
+// there are no workers to end, and the test cannot fail.)
+TEST(IsolatedCall, OneTbbsWorkersAreEndedBeforeTheFork) {
+  const int threads_before = thread_count(::getpid());
+  const int tbb_threads = start_tbb_workers();
+  EXPECT_EQ(thread_count(::getpid()), threads_before + tbb_threads - 1);
+  const IsolatedResult r =
+      call_isolated([] { return std::to_string(thread_count(::getppid())); }, kLimits);
+  ASSERT_EQ(r.status, Status::Done);
+  EXPECT_EQ(r.bytes, std::to_string(threads_before));
+  EXPECT_GE(start_tbb_workers(), 1);  // the caller's oneTBB works on
+}
+
+TEST(IsolatedCall, TheWorkMayRunParallelLoops) {
+  start_tbb_workers();
+  const IsolatedResult r = call_isolated(
+      [] {
+        const long sum = tbb::parallel_reduce(
+            tbb::blocked_range<long>(1, 100001), 0L,
+            [](const tbb::blocked_range<long>& range, long s) {
+              for (long i = range.begin(); i != range.end(); ++i) s += i;
+              return s;
+            },
+            [](long a, long b) { return a + b; });
+        return std::to_string(sum);
+      },
+      kLimits);
+  ASSERT_EQ(r.status, Status::Done);
+  EXPECT_EQ(r.bytes, "5000050000");
+}
+
+// Inside a parallel region oneTBB's workers cannot be ended, so no child is made and the work
+// does not run (the VDB reader then reads in the calling process).
+TEST(IsolatedCall, InsideAParallelLoopNothingIsForked) {
+  std::atomic<int> ran{0};
+  std::vector<Status> status(2);
+  tbb::parallel_for(0, 2, [&](int i) {
+    status[std::size_t(i)] = call_isolated(
+                                 [&] {
+                                   ++ran;
+                                   return std::string("x");
+                                 },
+                                 kLimits)
+                                 .status;
+  });
+  EXPECT_EQ(status[0], Status::NotIsolated);
+  EXPECT_EQ(status[1], Status::NotIsolated);
+  EXPECT_EQ(ran.load(), 0);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
+#include <tbb/global_control.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -32,6 +33,16 @@ std::uint64_t address_space_bytes() {
     status.ignore(1 << 16, '\n');
   }
   return 0;
+}
+
+// Ends oneTBB's worker threads, waiting for them, so that none holds a lock when fork() copies
+// the process: the child would wait for ever on a lock that a worker held at that moment, and
+// its work uses oneTBB (OpenVDB's tree destructor runs a parallel_for). False where oneTBB
+// cannot end them now: the caller is inside a parallel region, or another thread uses oneTBB.
+// The next parallel algorithm starts new workers.
+bool end_tbb_workers() {
+  tbb::task_scheduler_handle handle{tbb::attach{}};
+  return tbb::finalize(handle, std::nothrow);
 }
 
 void write_all(int fd, const char* bytes, std::size_t size) {
@@ -77,6 +88,7 @@ void write_all(int fd, const char* bytes, std::size_t size) {
 IsolatedResult call_isolated(const std::function<std::string()>& work,
                              const IsolationLimits& limits) {
   IsolatedResult result;
+  if (!end_tbb_workers()) return result;
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) return result;
   const std::uint64_t inherited = address_space_bytes();

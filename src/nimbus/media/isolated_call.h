@@ -22,7 +22,9 @@ struct IsolatedResult {
     OutOfMemory,  // `work` threw std::bad_alloc: it needed more than the memory limit
     TimedOut,     // the child ran past its CPU or wall-clock limit and was killed
     Crashed,      // the child died of `signal`, or ended without an answer
-    NotIsolated,  // no child could be made (fork failed); nothing ran
+    NotIsolated,  // no child could be made (fork failed, or oneTBB's worker threads could not
+                  // be ended first: the call came from inside a parallel region or while
+                  // another thread used oneTBB); nothing ran
   };
   Status status = Status::NotIsolated;
   std::string bytes;
@@ -31,8 +33,9 @@ struct IsolatedResult {
 
 // Calls `work` in a forked child, with its standard error sent to /dev/null, and returns what it
 // returned. `work` must turn its own expected failures into bytes; any other exception but
-// std::bad_alloc counts as a crash. The child runs only the calling thread, so `work` must not
-// start threads (oneTBB's included) or take locks that another thread of this process may hold.
+// std::bad_alloc counts as a crash. oneTBB's worker threads are ended before the fork, so `work`
+// may use oneTBB; it must not take locks that other threads of this process (not oneTBB's) may
+// hold.
 IsolatedResult call_isolated(const std::function<std::string()>& work,
                              const IsolationLimits& limits);
 
