@@ -14,26 +14,6 @@
 namespace nimbus {
 namespace {
 
-// The roots where a t² + b t + c changes sign, r0 < r1 (a double root changes no sign). Uses
-// the cancellation-free pair q / a, c / q with q = −(b + sign(b) √disc) / 2; when a → 0 the root
-// q / a runs off to ±∞ and c / q tends to the linear root −c / b, so a ≈ 0 needs no special case.
-int sign_change_roots(const RayQuadratic& p, double roots[2]) {
-  const double four_ac = 4 * p.a * p.c;
-  double disc = p.b * p.b - four_ac;
-  // Near a double root b² and 4ac cancel: recover the products' rounding errors by fma (Kahan).
-  // Only then, since without -mfma every fma is a libm call.
-  if (std::abs(disc) < 1e-6 * p.b * p.b)
-    disc = std::fma(p.b, p.b, -four_ac) + std::fma(-4 * p.a, p.c, four_ac);
-  if (!(disc > 0)) return 0;
-  const double q = -0.5 * (p.b + std::copysign(std::sqrt(disc), p.b));
-  double r0 = q / p.a, r1 = p.c / q;
-  if (r0 > r1) std::swap(r0, r1);
-  int count = 0;
-  if (std::isfinite(r0)) roots[count++] = r0;
-  if (std::isfinite(r1)) roots[count++] = r1;
-  return count;
-}
-
 std::optional<double> first_hit_quadric(const Quadric& quadric, const Ray& ray, double lo,
                                         double hi) {
   double roots[2];

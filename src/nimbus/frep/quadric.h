@@ -42,6 +42,10 @@ inline RayQuadratic restrict_to_ray(const Quadric& q, const Ray& r) {
   return {q.quadratic_form(r.d), dot(q.gradient(r.o), r.d), q.eval(r.o)};
 }
 
+// The roots where a t² + b t + c changes sign, r0 < r1, in `roots`; returns how many (a double
+// root changes no sign).
+int sign_change_roots(const RayQuadratic& p, double roots[2]);
+
 // The symmetric 4x4 matrix A with F = pᵀ A p on homogeneous p = (x, y, z, 1).
 Mat4 to_matrix(const Quadric& q);
 Quadric from_matrix(const Mat4& A);

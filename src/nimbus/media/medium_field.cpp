@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "nimbus/frep/quadric.h"
+
 namespace nimbus {
 
 double medium_density(const Medium& medium, const Vec3& x, double F) {
@@ -38,10 +40,35 @@ bool add_span(MediumIntervals& m, double a, double b) {
   return true;
 }
 
+namespace {
+
+// One quadric's stretches with F > 0 over [a, b], from both its roots at once (the general
+// search below finds one root per first_hit and evaluates the tape between them). Roots are
+// taken from a, as first_hit does, to keep their precision.
+bool add_quadric_spans(const Quadric& quadric, const Ray& ray, double a, double b,
+                       MediumIntervals& m) {
+  const RayQuadratic F = restrict_to_ray(quadric, Ray{ray.at(a), ray.d});
+  double roots[2];
+  const int count = sign_change_roots(F, roots);
+  double cuts[4] = {0};
+  int n = 1;
+  for (int i = 0; i < count; ++i)
+    if (roots[i] > 0 && roots[i] < b - a) cuts[n++] = roots[i];
+  cuts[n++] = b - a;
+  for (int i = 0; i + 1 < n; ++i)
+    if (F.at(0.5 * (cuts[i] + cuts[i + 1])) > 0 && !add_span(m, a + cuts[i], a + cuts[i + 1]))
+      return false;
+  return true;
+}
+
+}  // namespace
+
 bool add_object_spans(const Tape& tape, const Box& bounds, const Ray& ray, double t0, double t1,
                       MediumIntervals& m) {
   double a = t0, b = t1;
   if (!clip_ray(bounds, ray, a, b) || !(b > a)) return true;
+  if (tape.kind == TapeKind::SingleQuadric && std::isfinite(b))
+    return add_quadric_spans(tape.quadrics[0], ray, a, b, m);
   // Right after a root, first_hit may find the same root again, a few ulps on (a path that
   // scatters just inside the surface starts there): the next search starts this far past it.
   // A stretch is told inside or outside at its midpoint, so only a sliver thinner than this
