@@ -4,11 +4,9 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <thread>
 
 #include "nimbus/job/checkpoint.h"
 #include "support/process.h"
@@ -37,16 +35,32 @@ constexpr const char* kScene = R"({
 class Checkpoints : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("nimbus_ckcli_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = fresh_test_dir("nimbus_ckcli");
     std::ofstream(dir_ / "scene.json") << kScene;
   }
   void TearDown() override { fs::remove_all(dir_); }
   Ran nimbus(const std::string& args) {
-    return run_in(dir_, std::string("'") + NIMBUS_BINARY + "' render scene.json -q " + args);
+    return run_nimbus_in(dir_, "render scene.json -q " + args);
+  }
+  // A render of 300 spp on one thread, checkpointed every 0.05 s, started in the background;
+  // returns once its first checkpoint is written.
+  pid_t start_checkpointed_render(const std::vector<std::string>& outputs) {
+    std::vector<std::string> argv = {NIMBUS_BINARY,
+                                     "render",
+                                     "scene.json",
+                                     "-q",
+                                     "--spp",
+                                     "300",
+                                     "--threads",
+                                     "1",
+                                     "--checkpoint",
+                                     "ck.nck",
+                                     "--checkpoint-interval",
+                                     "0.05"};
+    argv.insert(argv.end(), outputs.begin(), outputs.end());
+    const pid_t pid = spawn_in(dir_, argv);
+    EXPECT_TRUE(wait_for_file(dir_ / "ck.nck"));
+    return pid;
   }
   fs::path dir_;
 };
@@ -77,24 +91,7 @@ TEST_F(Checkpoints, EightSamplesContinuedToTwentyFourAreOneRenderOfTwentyFour) {
 
 // Killed outright (SIGKILL) while rendering, then resumed: the pixels of an uninterrupted render.
 TEST_F(Checkpoints, KilledAndResumedIsTheUninterruptedRender) {
-  const std::vector<std::string> argv = {NIMBUS_BINARY,
-                                         "render",
-                                         "scene.json",
-                                         "-q",
-                                         "--spp",
-                                         "300",
-                                         "--threads",
-                                         "1",
-                                         "--checkpoint",
-                                         "ck.nck",
-                                         "--checkpoint-interval",
-                                         "0.05",
-                                         "-o",
-                                         "out.exr"};
-  const pid_t pid = spawn_in(dir_, argv);
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (!fs::exists(dir_ / "ck.nck") && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const pid_t pid = start_checkpointed_render({"-o", "out.exr"});
   ASSERT_EQ(::kill(pid, SIGKILL), 0);
   ASSERT_EQ(wait_for(pid), 128 + SIGKILL) << "the render ended before it was killed";
   EXPECT_FALSE(fs::exists(dir_ / "out.exr"));
@@ -114,26 +111,7 @@ TEST_F(Checkpoints, KilledAndResumedIsTheUninterruptedRender) {
 
 // Ctrl-C: the checkpoint and the image so far, written whole; the resume finishes the render.
 TEST_F(Checkpoints, InterruptedWritesTheImageSoFarAndResumes) {
-  const std::vector<std::string> argv = {NIMBUS_BINARY,
-                                         "render",
-                                         "scene.json",
-                                         "-q",
-                                         "--spp",
-                                         "300",
-                                         "--threads",
-                                         "1",
-                                         "--checkpoint",
-                                         "ck.nck",
-                                         "--checkpoint-interval",
-                                         "0.05",
-                                         "-o",
-                                         "out.exr",
-                                         "-o",
-                                         "out.png"};
-  const pid_t pid = spawn_in(dir_, argv);
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (!fs::exists(dir_ / "ck.nck") && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const pid_t pid = start_checkpointed_render({"-o", "out.exr", "-o", "out.png"});
   ASSERT_EQ(::kill(pid, SIGINT), 0);
   ASSERT_EQ(wait_for(pid), 130);
   EXPECT_TRUE(fs::exists(dir_ / "out.png"));

@@ -2,35 +2,27 @@
 // no output left behind by a failed run, and the outputs of a good one.
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
+#include "support/process.h"
+
 namespace {
 
 namespace fs = std::filesystem;
-
-struct Outcome {
-  int code;
-  std::string err;
-};
+using nimbus::testing::fresh_test_dir;
+using nimbus::testing::Ran;
+using nimbus::testing::run_nimbus_in;
 
 class Cli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("nimbus_cli_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
+  void SetUp() override { dir_ = fresh_test_dir("nimbus_cli"); }
   void TearDown() override { fs::remove_all(dir_); }
 
   std::string write(const std::string& name, const std::string& text) {
@@ -38,17 +30,7 @@ class Cli : public ::testing::Test {
     std::ofstream(p) << text;
     return p.string();
   }
-  Outcome run(const std::string& args) {
-    const std::string err_file = (dir_ / "stderr.txt").string();
-    const std::string cmd = "cd '" + dir_.string() + "' && '" + NIMBUS_BINARY + "' " + args +
-                            " >/dev/null 2>'" + err_file + "'";
-    const int status = std::system(cmd.c_str());
-    std::ifstream f(err_file);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    fs::remove(err_file);
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, ss.str()};
-  }
+  Ran run(const std::string& args) { return run_nimbus_in(dir_, args); }
   // Everything left in the directory besides the scene files.
   std::vector<std::string> outputs() const {
     std::vector<std::string> out;
@@ -148,7 +130,7 @@ TEST_F(Cli, MalformedScenesExitTwoWithOneLineAndNoOutput) {
       text = j.dump(2);
     }
     write("scene.json", text);
-    const Outcome r = run("render scene.json --quiet");
+    const Ran r = run("render scene.json --quiet");
     EXPECT_EQ(r.code, 2) << c.name << ": " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.name << ": " << r.err;
     EXPECT_EQ(r.err.rfind("scene.json: ", 0), 0u) << c.name << ": " << r.err;
@@ -165,34 +147,34 @@ TEST_F(Cli, UsageErrorsExitTwo) {
   EXPECT_EQ(run("").code, 2);
   EXPECT_EQ(run("render").code, 2);
   // Range errors say the range in words (issue 16), not CLI11's double bounds.
-  const Outcome spp0 = run("render scene.json --spp 0");
+  const Ran spp0 = run("render scene.json --spp 0");
   EXPECT_EQ(spp0.code, 2);
   EXPECT_NE(spp0.err.find("--spp: must be >= 1, not 0"), std::string::npos) << spp0.err;
-  const Outcome huge = run("render scene.json --spp 1099511627776");
+  const Ran huge = run("render scene.json --spp 1099511627776");
   EXPECT_EQ(huge.code, 2);
   EXPECT_NE(huge.err.find("--spp: must be <= 2147483647, not 1099511627776"), std::string::npos)
       << huge.err;
-  const Outcome threads0 = run("render scene.json --threads 0");
+  const Ran threads0 = run("render scene.json --threads 0");
   EXPECT_EQ(threads0.code, 2);
   EXPECT_NE(threads0.err.find("--threads: must be >= 1, not 0"), std::string::npos) << threads0.err;
-  const Outcome words = run("render scene.json --seed many");
+  const Ran words = run("render scene.json --seed many");
   EXPECT_EQ(words.code, 2);
   EXPECT_NE(words.err.find("--seed: must be a whole number, not \"many\""), std::string::npos)
       << words.err;
-  const Outcome set_huge = run("render scene.json --set integrator.spp=1099511627776");
+  const Ran set_huge = run("render scene.json --set integrator.spp=1099511627776");
   EXPECT_EQ(set_huge.code, 2);
   EXPECT_EQ(set_huge.err,
             "--set integrator.spp=1099511627776: /integrator/spp: must be in [1, 2147483647]\n");
   EXPECT_EQ(run("render scene.json --bogus").code, 2);
-  const Outcome missing = run("render nowhere.json");
+  const Ran missing = run("render nowhere.json");
   EXPECT_EQ(missing.code, 2);
   EXPECT_NE(missing.err.find("nowhere.json: cannot open file"), std::string::npos) << missing.err;
-  const Outcome bad_ext = run("render scene.json -o out.jpg");
+  const Ran bad_ext = run("render scene.json -o out.jpg");
   EXPECT_EQ(bad_ext.code, 2);
   EXPECT_NE(bad_ext.err.find("out.jpg: unknown image format"), std::string::npos) << bad_ext.err;
-  const Outcome bad_dir = run("render scene.json -o nodir/out.png");
+  const Ran bad_dir = run("render scene.json -o nodir/out.png");
   EXPECT_EQ(bad_dir.code, 2);
-  const Outcome bad_set = run("render scene.json --set integrator.spp=abc");
+  const Ran bad_set = run("render scene.json --set integrator.spp=abc");
   EXPECT_EQ(bad_set.code, 2);
   EXPECT_NE(bad_set.err.find("--set integrator.spp=abc"), std::string::npos) << bad_set.err;
   EXPECT_TRUE(outputs().empty());
@@ -202,8 +184,7 @@ TEST_F(Cli, UsageErrorsExitTwo) {
 
 TEST_F(Cli, RendersDefaultOutputsAndStats) {
   write("scene.json", good_scene().dump());
-  const Outcome r =
-      run("render scene.json --stats stats.json --set film.width=8 --spp 3 --threads 2");
+  const Ran r = run("render scene.json --stats stats.json --set film.width=8 --spp 3 --threads 2");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir_ / "scene.exr"));
   EXPECT_TRUE(fs::exists(dir_ / "scene.png"));
@@ -244,7 +225,7 @@ TEST_F(Cli, OverflowingSamplesAreRejectedCountedAndReported) {
   nlohmann::json scene = good_scene();
   scene["lights"][0]["radiance"] = 1e200;
   write("scene.json", scene.dump());
-  const Outcome r = run("render scene.json --stats stats.json --spp 2 -o out.exr");
+  const Ran r = run("render scene.json --stats stats.json --spp 2 -o out.exr");
   ASSERT_EQ(r.code, 0) << r.err;
   std::ifstream f(dir_ / "stats.json");
   const nlohmann::json s = nlohmann::json::parse(f);
@@ -260,7 +241,7 @@ TEST_F(Cli, OverflowingSamplesAreRejectedCountedAndReported) {
 
 TEST_F(Cli, RendersInSpectralModeFromTheCommandLine) {
   write("scene.json", good_scene().dump());
-  const Outcome r =
+  const Ran r =
       run("render scene.json --stats stats.json --set film.width=8 --spp 2 --set "
           "spectrum.mode=spectral "
           "--set spectrum.wavelengths=12 -o s.exr --quiet");
@@ -273,8 +254,8 @@ TEST_F(Cli, RendersInSpectralModeFromTheCommandLine) {
   for (int c = 0; c < 3; ++c) EXPECT_GT(s["image_mean"][c].get<double>(), 0);
   // A wavelength count this build does not render is a scene error: exit 2, one line, no output.
   for (const char* n : {"6", "32"}) {
-    const Outcome bad = run(std::string("render scene.json --set spectrum.mode=spectral ") +
-                            "--set spectrum.wavelengths=" + n + " -o bad.exr");
+    const Ran bad = run(std::string("render scene.json --set spectrum.mode=spectral ") +
+                        "--set spectrum.wavelengths=" + n + " -o bad.exr");
     EXPECT_EQ(bad.code, 2);
     EXPECT_NE(bad.err.find("/spectrum/wavelengths: must be one of 4, 8, 12, 16 (the counts this "
                            "build renders: CMake option NIMBUS_WAVELENGTH_COUNTS)\n"),
@@ -335,14 +316,14 @@ TEST_F(Cli, SignalsStopTheOctreeBuildAndWriteNothing) {
 // before anything large is allocated and refused past the available memory or --max-memory.
 TEST_F(Cli, RendersThatWouldNotFitAreRefusedUpFront) {
   write("scene.json", good_scene().dump());
-  const Outcome big = run(
+  const Ran big = run(
       "render scene.json --set film.width=16384 --set film.height=16384 --max-memory 16G -o a.png");
   EXPECT_EQ(big.code, 2);
   EXPECT_EQ(big.err,
             "nimbus: the render needs about 25.0 GiB (film 19.0 GiB, image 6.0 GiB, majorant "
             "octrees 42.0 MiB), more than the 16.0 GiB allowed by --max-memory\n");
   EXPECT_TRUE(outputs().empty());
-  const Outcome bad = run("render scene.json --max-memory 10x -o a.png");
+  const Ran bad = run("render scene.json --max-memory 10x -o a.png");
   EXPECT_EQ(bad.code, 2);
   EXPECT_EQ(bad.err, "nimbus: --max-memory: \"10x\": unknown size suffix \"x\" (K, M, G or T)\n");
   EXPECT_EQ(run("render scene.json --max-memory 1.5G --spp 1 -o a.png").code, 0);

@@ -4,12 +4,10 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <thread>
 
 #include "nimbus/job/checkpoint.h"
 #include "support/process.h"
@@ -44,18 +42,14 @@ class Mpi : public ::testing::Test {
 #ifndef NIMBUS_MPIEXEC
     GTEST_SKIP() << "built without MPI (CMake found none)";
 #endif
-    dir_ = fs::temp_directory_path() /
-           ("nimbus_mpi_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = fresh_test_dir("nimbus_mpi");
     std::ofstream(dir_ / "scene.json") << kScene;
   }
   void TearDown() override {
     if (!dir_.empty()) fs::remove_all(dir_);
   }
   Ran nimbus(const std::string& args) {
-    return run_in(dir_, std::string("'") + NIMBUS_BINARY + "' render scene.json -q " + args);
+    return run_nimbus_in(dir_, "render scene.json -q " + args);
   }
   // OpenMPI refuses root unless told (CI runs as root); -q drops mpirun's own report of a rank's
   // non-zero exit, so that stderr holds what nimbus printed. OpenMPI's dynamically loaded
@@ -169,9 +163,7 @@ TEST_F(Mpi, ARankKilledLeavesNoOutputAndTheCheckpointResumes) {
                                          "out.exr",
                                          "-o",
                                          "out.png"});
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (!fs::exists(dir_ / "ck.nck") && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_TRUE(wait_for_file(dir_ / "ck.nck"));
   const pid_t rank1 = rank_process(launcher, 1);
   ASSERT_GT(rank1, 0);
   ASSERT_EQ(::kill(rank1, SIGKILL), 0);

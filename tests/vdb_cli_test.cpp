@@ -4,36 +4,27 @@
 // renders, and refuses bad input with exit 2, one line and no output.
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include "support/process.h"
 #include "support/vdb_grids.h"
 
 namespace {
 
 namespace fs = std::filesystem;
-
-struct Outcome {
-  int code;
-  std::string out, err;
-};
+using nimbus::testing::fresh_test_dir;
+using nimbus::testing::Ran;
+using nimbus::testing::run_in;
 
 class VdbCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("nimbus_vdb_cli_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
+  void SetUp() override { dir_ = fresh_test_dir("nimbus_vdb_cli"); }
   void TearDown() override { fs::remove_all(dir_); }
 
   std::string file(const std::string& name) const { return (dir_ / name).string(); }
@@ -41,20 +32,8 @@ class VdbCli : public ::testing::Test {
     std::ofstream(file(name)) << text;
   }
   // Runs a command in the directory; `program` defaults to nimbus.
-  Outcome run(const std::string& args, const std::string& program = NIMBUS_BINARY) {
-    const std::string out_file = file("stdout.txt"), err_file = file("stderr.txt");
-    const std::string cmd = "cd '" + dir_.string() + "' && '" + program + "' " + args + " >'" +
-                            out_file + "' 2>'" + err_file + "'";
-    const int status = std::system(cmd.c_str());
-    const auto slurp = [](const std::string& path) {
-      std::ifstream f(path);
-      std::stringstream ss;
-      ss << f.rdbuf();
-      fs::remove(path);
-      return ss.str();
-    };
-    const std::string out = slurp(out_file);
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out, slurp(err_file)};
+  Ran run(const std::string& args, const std::string& program = NIMBUS_BINARY) {
+    return run_in(dir_, "'" + program + "' " + args);
   }
   // Everything in the directory besides the inputs.
   std::vector<std::string> outputs(const std::vector<std::string>& inputs) const {
@@ -110,7 +89,7 @@ TEST_F(VdbCli, ABadVdbFileExitsTwoWithOneLineAndNoOutput) {
     for (const std::string& command :
          {std::string("render scene.json -o out.png --quiet"),
           std::string("export-vdb scene.json -o out.vdb --voxel-size 0.1 --quiet")}) {
-      const Outcome r = run(command);
+      const Ran r = run(command);
       EXPECT_EQ(r.code, 2) << command << ": " << r.err;
       EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
       EXPECT_EQ(r.err.rfind(c.message, 0), 0u) << "expected \"" << c.message << "\" in: " << r.err;
@@ -126,7 +105,7 @@ TEST_F(VdbCli, ABadVdbFileExitsTwoWithOneLineAndNoOutput) {
 
 TEST_F(VdbCli, ExportVdbWritesAFileThatOpenVdbReadsAndThatRenders) {
   write("scene.json", scene_with());
-  const Outcome r = run("export-vdb scene.json -o cloud.vdb --voxel-size 0.05");
+  const Ran r = run("export-vdb scene.json -o cloud.vdb --voxel-size 0.05");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("object 1: "), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("-> cloud.vdb"), std::string::npos) << r.err;
@@ -134,7 +113,7 @@ TEST_F(VdbCli, ExportVdbWritesAFileThatOpenVdbReadsAndThatRenders) {
 
   const std::string vdb_print = "/usr/bin/vdb_print";
   if (fs::exists(vdb_print)) {
-    const Outcome p = run("-l cloud.vdb", vdb_print);
+    const Ran p = run("-l cloud.vdb", vdb_print);
     EXPECT_EQ(p.code, 0) << p.err;
     for (const char* expected : {"Name: density", "class: fog volume", "sigma_s: [1, 2, 3]",
                                  "phase_g: 0", "voxel size: 0.05", "creator: nimbus"})
@@ -170,7 +149,7 @@ TEST_F(VdbCli, ExportVdbRefusesBadInputWithExitTwoAndNoOutput) {
       {"export-vdb nowhere.json -o out.vdb --voxel-size 0.1", "nowhere.json: cannot open file"},
   };
   for (const Case& c : cases) {
-    const Outcome r = run(c.args);
+    const Ran r = run(c.args);
     EXPECT_EQ(r.code, 2) << c.args << ": " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.args << ": " << r.err;
     EXPECT_EQ(r.err.rfind(c.message, 0), 0u)
