@@ -21,6 +21,7 @@
 #include "nimbus/render/volume.h"
 #include "support/chandrasekhar.h"
 #include "support/film_chi2.h"
+#include "support/pixel_references.h"
 #include "support/scene_builders.h"
 #include "support/stats.h"
 #include "support/weight_growth.h"
@@ -233,21 +234,6 @@ bool inside_the_outline(const Camera& camera, int pixel, int width) {
   return true;
 }
 
-// Each pixel's mean of radiance(ray) over a k × k grid of its footprint.
-std::vector<Rgb> pixel_references(const Camera& camera, int width, int height, int k,
-                                  const std::function<Rgb(const Ray&)>& radiance) {
-  std::vector<Rgb> ref(size_t(width) * height);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      Rgb sum(0.0);
-      for (int i = 0; i < k; ++i)
-        for (int j = 0; j < k; ++j)
-          sum += radiance(camera.generate(x + (i + 0.5) / k, y + (j + 0.5) / k));
-      ref[size_t(y) * width + x] = sum / double(k * k);
-    }
-  return ref;
-}
-
 // The per-pixel chi-square of a render of the unit sphere against reference pixel values,
 // inside its outline.
 test::Chi2 sphere_chi2(const RenderResult& r, const Camera& camera, const std::vector<Rgb>& ref) {
@@ -277,7 +263,7 @@ TEST_P(MediaRender, EmittingFieldAbsorberMatchesClosedForm) {
   const RenderResult r = render_absorber(tracking(), 1.0);
   const Camera& camera = absorber_camera();
   const std::vector<Rgb> ref =
-      pixel_references(camera, r.film.width, r.film.height, 24, absorber_radiance);
+      test::pixel_references(camera, r.film.width, r.film.height, 24, absorber_radiance);
   const test::Chi2 chi2 = sphere_chi2(r, camera, ref);
   ASSERT_EQ(chi2.dof, 3 * 224);
   EXPECT_TRUE(chi2.passes()) << "chi2 " << chi2.value << " over " << chi2.dof;
@@ -473,7 +459,7 @@ Rgb single_scattering_radiance(const Ray& ray) {
 TEST_P(MediaRender, SingleScatteringInAChromaticFieldMatchesQuadrature) {
   SKIP_IF_UNFIT((MediumTraits{kSingleSigmaA, kSingleSigmaS, false, false}));
   const Scene scene = single_scattering_scene(tracking(), 0.0);
-  const std::vector<Rgb> ref = pixel_references(
+  const std::vector<Rgb> ref = test::pixel_references(
       scene.camera, scene.settings.width, scene.settings.height, 6, single_scattering_radiance);
   const RenderResult r = render(scene);
   const test::Chi2 chi2 = sphere_chi2(r, scene.camera, ref);

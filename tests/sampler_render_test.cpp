@@ -17,6 +17,7 @@
 #include "nimbus/media/field_density.h"
 #include "nimbus/render/renderer.h"
 #include "support/chandrasekhar.h"
+#include "support/pixel_references.h"
 #include "support/scene_builders.h"
 #include "support/stats.h"
 
@@ -69,21 +70,6 @@ void expect_zsobol_wins(const std::function<Scene(Sampler, uint64_t)>& make,
               z.mse.mean, i.mse.mean, z.mse.mean / i.mse.mean, margin);
 }
 
-// Each pixel's mean of radiance(ray) over a k × k grid of its footprint.
-std::vector<Rgb> pixel_references(const Camera& camera, int width, int height, int k,
-                                  const std::function<Rgb(const Ray&)>& radiance) {
-  std::vector<Rgb> ref(size_t(width) * height);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      Rgb sum(0.0);
-      for (int i = 0; i < k; ++i)
-        for (int j = 0; j < k; ++j)
-          sum += radiance(camera.generate(x + (i + 0.5) / k, y + (j + 0.5) / k));
-      ref[size_t(y) * width + x] = sum / double(k * k);
-    }
-  return ref;
-}
-
 // An emitting absorber of density 1 − |x|² in the unit sphere before an environment of radiance
 // 1: L = T + L_e (1 − T), ∫ density along a chord at distance b from the centre = 4/3 (1 − b²)^1.5.
 // The camera's numbers and the tracking stream.
@@ -121,7 +107,7 @@ Rgb absorber_radiance(const Ray& ray) {
 }
 
 TEST(SamplerRender, AbsorberZSobolBeatsIndependent) {
-  const auto ref = pixel_references(absorber_camera(), 20, 20, 32, absorber_radiance);
+  const auto ref = test::pixel_references(absorber_camera(), 20, 20, 32, absorber_radiance);
   // Measured: MSE ratio 0.90 (the difference 1.7 times the margin); most of the error is the
   // tracking stream's (tentative collisions after the first).
   expect_zsobol_wins(absorber, ref, 24);
@@ -153,7 +139,7 @@ Scene lit_floor(Sampler sampler, uint64_t seed) {
 }
 
 TEST(SamplerRender, SphereLightOnFloorZSobolBeatsIndependent) {
-  const auto ref = pixel_references(floor_camera(), 16, 16, 32, [](const Ray& ray) {
+  const auto ref = test::pixel_references(floor_camera(), 16, 16, 32, [](const Ray& ray) {
     const Vec3 p = ray.at(-ray.o.y / ray.d.y), to_c = kLightC - p;
     const double d2 = dot(to_c, to_c);
     return Rgb(kFloorAlbedo * kLightL * kLightR * kLightR * (to_c.y / std::sqrt(d2)) / d2);
