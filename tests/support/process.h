@@ -63,15 +63,17 @@ inline Ran run_nimbus_in(const std::filesystem::path& dir, const std::string& ar
 
 // Starts `argv` in `dir` with stdout and stderr to /dev/null; returns its pid.
 inline pid_t spawn_in(const std::filesystem::path& dir, const std::vector<std::string>& argv) {
+  // Built before fork(): between fork and exec the child makes system calls only, no allocation
+  // (another thread may have held the allocator's lock at the fork).
+  std::vector<char*> args;
+  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
   const pid_t pid = fork();
   if (pid == 0) {
     if (chdir(dir.c_str()) != 0) _exit(127);
     const int null = open("/dev/null", O_WRONLY);
     dup2(null, 1);
     dup2(null, 2);
-    std::vector<char*> args;
-    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
     execv(args[0], args.data());
     _exit(127);
   }
