@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -43,7 +45,7 @@ Tape general_tape(const ShapePtr& shape) {
 
 bool inside(const MediumIntervals& m, double t) {
   for (int i = 0; i < m.count; ++i)
-    if (t >= m.spans[i].first && t <= m.spans[i].second) return true;
+    if (t >= m.spans[i].t0 && t <= m.spans[i].t1) return true;
   return false;
 }
 
@@ -64,8 +66,8 @@ TEST(ObjectSpans, OneQuadricAgreesWithTheSampledFieldAndTheGeneralPath) {
       ASSERT_TRUE(add_object_spans(general, bounds, ray, t0, t1, b));
       ASSERT_EQ(a.count, b.count) << q.name << " ray " << i;
       for (int s = 0; s < a.count; ++s) {
-        EXPECT_NEAR(a.spans[s].first, b.spans[s].first, 1e-8) << q.name << " ray " << i;
-        EXPECT_NEAR(a.spans[s].second, b.spans[s].second, 1e-8) << q.name << " ray " << i;
+        EXPECT_NEAR(a.spans[s].t0, b.spans[s].t0, 1e-8) << q.name << " ray " << i;
+        EXPECT_NEAR(a.spans[s].t1, b.spans[s].t1, 1e-8) << q.name << " ray " << i;
       }
       two_spans += a.count == 2;
       // Inside the bounds, F's sign away from the surface decides membership (the ends are left
@@ -85,6 +87,56 @@ TEST(ObjectSpans, OneQuadricAgreesWithTheSampledFieldAndTheGeneralPath) {
       EXPECT_GT(two_spans, 15);
     }
   }
+}
+
+// The union of closed intervals, sorted, with touching ones joined: the reference for add_span.
+std::vector<Span> merged(std::vector<Span> all) {
+  std::sort(all.begin(), all.end(), [](const Span& x, const Span& y) { return x.t0 < y.t0; });
+  std::vector<Span> out;
+  for (const Span& s : all)
+    if (!out.empty() && s.t0 <= out.back().t1)
+      out.back().t1 = std::max(out.back().t1, s.t1);
+    else
+      out.push_back(s);
+  return out;
+}
+
+TEST(ObjectSpans, AddSpanKeepsTheSortedUnionAndRefusesOverflowUnchanged) {
+  Rng rng(9);
+  int refused = 0, merges = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    MediumIntervals m;
+    std::vector<Span> added;
+    const int n = 1 + int(rng.uniform() * 80);
+    for (int k = 0; k < n; ++k) {
+      // Endpoints on a coarse grid, so that spans often touch exactly.
+      const double a = std::floor(rng.uniform() * 800) / 4,
+                   b = a + std::floor(rng.uniform() * 8) / 4;
+      const MediumIntervals before = m;
+      std::vector<Span> with = added;
+      with.push_back({a, b});
+      const std::vector<Span> expected = merged(with);
+      if (!add_span(m, a, b)) {
+        ASSERT_GT(expected.size(), std::size_t(MediumIntervals::kMax)) << trial;
+        ASSERT_EQ(m.count, before.count);
+        for (int i = 0; i < m.count; ++i) {
+          ASSERT_EQ(m.spans[i].t0, before.spans[i].t0);
+          ASSERT_EQ(m.spans[i].t1, before.spans[i].t1);
+        }
+        ++refused;
+        continue;
+      }
+      added = with;
+      merges += int(expected.size()) < m.count + 1;
+      ASSERT_EQ(m.count, int(expected.size())) << trial << " " << k;
+      for (int i = 0; i < m.count; ++i) {
+        ASSERT_EQ(m.spans[i].t0, expected[i].t0) << trial << " " << k;
+        ASSERT_EQ(m.spans[i].t1, expected[i].t1) << trial << " " << k;
+      }
+    }
+  }
+  EXPECT_GT(refused, 1000);
+  EXPECT_GT(merges, 10000);
 }
 
 }  // namespace

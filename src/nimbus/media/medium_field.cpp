@@ -12,31 +12,23 @@ double medium_density(const Medium& medium, const Vec3& x, double F) {
 }
 
 bool add_span(MediumIntervals& m, double a, double b) {
-  // Merge every span that overlaps or touches [a, b] into it, then insert it in order.
-  int keep = 0;
-  std::array<std::pair<double, double>, MediumIntervals::kMax> out;
-  bool placed = false;
-  for (int i = 0; i < m.count; ++i) {
-    const auto [lo, hi] = m.spans[i];
-    if (hi < a || lo > b) {
-      if (!placed && lo > b) {
-        if (keep == MediumIntervals::kMax) return false;
-        out[keep++] = {a, b};
-        placed = true;
-      }
-      if (keep == MediumIntervals::kMax) return false;
-      out[keep++] = {lo, hi};
-    } else {
-      a = std::min(a, lo);
-      b = std::max(b, hi);
-    }
+  // Spans [i, j) overlap or touch [a, b]: they merge with it into one span at i, in place.
+  int i = 0;
+  while (i < m.count && m.spans[i].t1 < a) ++i;
+  int j = i;
+  for (; j < m.count && m.spans[j].t0 <= b; ++j) {
+    a = std::min(a, m.spans[j].t0);
+    b = std::max(b, m.spans[j].t1);
   }
-  if (!placed) {
-    if (keep == MediumIntervals::kMax) return false;
-    out[keep++] = {a, b};
-  }
-  m.spans = out;
-  m.count = keep;
+  const int count = m.count + 1 - (j - i);
+  if (count > MediumIntervals::kMax) return false;
+  Span* const spans = m.spans.data();
+  if (j == i)
+    std::copy_backward(spans + j, spans + m.count, spans + count);
+  else
+    std::copy(spans + j, spans + m.count, spans + i + 1);
+  spans[i] = {a, b};
+  m.count = count;
   return true;
 }
 

@@ -133,10 +133,16 @@ struct MajorantSegment {
 // index-matched medium object's F > 0, found from the exact roots of F along the ray (its
 // surface, frep/intersect.h), sorted and disjoint. Surfaces are exact, so an octree leaf that
 // straddles an object's boundary costs nothing outside it.
+// A stretch [t0, t1] of a ray. Without initialisers, so that the spans of a walk are not
+// zero-filled each time (only the first `count` are ever read).
+struct Span {
+  double t0, t1;
+};
+
 struct MediumIntervals {
   static constexpr int kMax = 32;
   int count = 0;
-  std::array<std::pair<double, double>, kMax> spans;
+  std::array<Span, kMax> spans;
 };
 
 // How far past a root, relative to the object's size, the search for the next one starts
@@ -225,12 +231,11 @@ void walk_majorant_segments(const S& scene, const Channels<N>& ch, const Ray& ra
       spans = field_medium_intervals(scene, ray, t0, t1);
       have_spans = true;
     }
-    while (span < spans.count && spans.spans[span].second <= a) ++span;
+    while (span < spans.count && spans.spans[span].t1 <= a) ++span;
     if (span == spans.count) return false;
-    if (spans.spans[span].first >= b) return true;
-    for (int k = span; k < spans.count && spans.spans[k].first < b; ++k)
-      if (!emit(std::max(a, spans.spans[k].first), std::min(b, spans.spans[k].second), mu_bar,
-                mu_c))
+    if (spans.spans[span].t0 >= b) return true;
+    for (int k = span; k < spans.count && spans.spans[k].t0 < b; ++k)
+      if (!emit(std::max(a, spans.spans[k].t0), std::min(b, spans.spans[k].t1), mu_bar, mu_c))
         return false;
     return true;
   });
