@@ -129,16 +129,16 @@ struct MajorantSegment {
   Spectrum<N> mu_c{0.0};
 };
 
-// Where the field's media can be along a ray: the stretches of [t_min, t_max] where some
-// index-matched medium object's F > 0, found from the exact roots of F along the ray (its
-// surface, frep/intersect.h), sorted and disjoint. Surfaces are exact, so an octree leaf that
-// straddles an object's boundary costs nothing outside it.
 // A stretch [t0, t1] of a ray. Without initialisers, so that the spans of a walk are not
 // zero-filled each time (only the first `count` are ever read).
 struct Span {
   double t0, t1;
 };
 
+// Where the field's media can be along a ray: the stretches of [t_min, t_max] where some
+// index-matched medium object's F > 0, found from the exact roots of F along the ray (its
+// surface, frep/intersect.h), sorted and disjoint. Surfaces are exact, so an octree leaf that
+// straddles an object's boundary costs nothing outside it.
 struct MediumIntervals {
   static constexpr int kMax = 32;
   int count = 0;
@@ -149,7 +149,8 @@ struct MediumIntervals {
 // (add_object_spans).
 inline constexpr double kRootSkip = 1e-9;
 
-// Adds [a, b] to sorted disjoint spans, merging overlaps. False when there is no room left.
+// Adds [a, b] to sorted disjoint spans, merging those it overlaps or touches. False, leaving m
+// as it was, when there is no room left.
 bool add_span(MediumIntervals& m, double a, double b);
 
 // The object's stretches with F > 0 over [t0, t1] (within its bounds), added to m. False when m
