@@ -127,7 +127,7 @@ TEST(ObjectSpans, AddSpanKeepsTheSortedUnionAndRefusesOverflowUnchanged) {
         continue;
       }
       added = with;
-      merges += int(expected.size()) < m.count + 1;
+      merges += int(expected.size()) < before.count + 1;  // [a, b] joined a span
       ASSERT_EQ(m.count, int(expected.size())) << trial << " " << k;
       for (int i = 0; i < m.count; ++i) {
         ASSERT_EQ(m.spans[i].t0, expected[i].t0) << trial << " " << k;
