@@ -13,10 +13,11 @@
 # the one-line error the test checks).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-CXX=clang++ cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNIMBUS_SANITIZE=ON \
+source tools/phase.sh
+phase "sanitized configure" env CXX=clang++ cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNIMBUS_SANITIZE=ON \
   -DNIMBUS_BUILD_FUZZER=ON -DNIMBUS_BUILD_BENCH=OFF >/dev/null
-cmake --build build-sanitize -j"$(nproc)"
+phase "sanitized build" cmake --build build-sanitize -j"$(nproc)"
 repeats='Modes/(MediaRender|SpectralRender)\.(Chandrasekhar|EmittingField|SingleScattering)'
-ctest --test-dir build-sanitize --output-on-failure -j"$(nproc)" \
+phase "sanitized tests" ctest --test-dir build-sanitize --output-on-failure -j"$(nproc)" \
   -E "^InstallAndEmbed$|^${repeats}|^Modes/SpectralRender\.EmissiveFurnace|^ImageChecksums$"
-bash tools/fuzz.sh --runs 200000
+phase "fuzzing" bash tools/fuzz.sh --runs 200000

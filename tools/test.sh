@@ -3,9 +3,10 @@
 # again under sanitizers and fuzzes the scene loader briefly (tools/sanitize.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash tools/setup.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build build -j"$(nproc)"
-ctest --test-dir build --output-on-failure -j"$(nproc)"
+source tools/phase.sh
+phase "set-up" bash tools/setup.sh
+phase "Release configure" cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+phase "Release build" cmake --build build -j"$(nproc)"
+phase "Release tests" ctest --test-dir build --output-on-failure -j"$(nproc)"
 # The sanitized pass (clang, ASan, UBSan) and a fixed fuzzing run: tools/sanitize.sh.
 bash tools/sanitize.sh
