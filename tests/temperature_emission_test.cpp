@@ -10,9 +10,6 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
-#include <openvdb/io/File.h>
-#include <openvdb/openvdb.h>
-#include <openvdb/tools/LevelSetSphere.h>
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -41,23 +38,14 @@ constexpr double kVoxel = 0.1;
 
 // A float grid named `name` whose voxels (i, j, k) in [lo, hi] are active and hold value(i, j,
 // k); voxel size kVoxel, index (0, 0, 0) at the world origin.
-openvdb::FloatGrid::Ptr grid_of(const std::string& name, const openvdb::Coord& lo,
-                                const openvdb::Coord& hi,
-                                const std::function<double(int, int, int)>& value) {
-  openvdb::FloatGrid::Ptr g = openvdb::FloatGrid::create(0.0f);
-  g->setName(name);
-  g->setTransform(openvdb::math::Transform::createLinearTransform(kVoxel));
-  auto acc = g->getAccessor();
-  for (int i = lo.x(); i <= hi.x(); ++i)
-    for (int j = lo.y(); j <= hi.y(); ++j)
-      for (int k = lo.z(); k <= hi.z(); ++k)
-        acc.setValueOn({i, j, k}, static_cast<float>(value(i, j, k)));
+test::FloatGrid grid_of(const std::string& name, const test::Coord& lo, const test::Coord& hi,
+                        const std::function<double(int, int, int)>& value) {
+  test::FloatGrid g{.name = name, .voxel = kVoxel};
+  for (int i = lo.i; i <= hi.i; ++i)
+    for (int j = lo.j; j <= hi.j; ++j)
+      for (int k = lo.k; k <= hi.k; ++k)
+        g.voxels.push_back({{i, j, k}, static_cast<float>(value(i, j, k))});
   return g;
-}
-
-void write_grids(const std::string& file, const openvdb::GridPtrVec& grids) {
-  openvdb::initialize();
-  openvdb::io::File(file).write(grids);
 }
 
 // The luminance of Planck's radiance at T.
@@ -127,8 +115,8 @@ TEST_P(TemperatureGrid, ConstantTemperatureRendersAsTheBlackbodyColour) {
   const std::string mode = GetParam();
   const TempDir dir("temperature_constant");
   constexpr double kKelvin = 1800, kEnv = 0.5;
-  write_grids(dir.file("fire.vdb"), {grid_of("temperature", {-3, -3, -3}, {13, 13, 13},
-                                             [](int, int, int) { return kKelvin; })});
+  test::write_vdb(dir.file("fire.vdb"), {grid_of("temperature", {-3, -3, -3}, {13, 13, 13},
+                                                 [](int, int, int) { return kKelvin; })});
   const double s = 2 / planck_luminance(kKelvin);  // luminance 2
   const std::string camera =
       R"({"type": "orthographic", "from": [0.5, 0.5, 3], "to": [0.5, 0.5, 0], "width": 0.8})";
@@ -190,9 +178,9 @@ TEST_P(TemperatureGrid, GradientMatchesQuadratureAlongTheRay) {
   const TempDir dir("temperature_gradient");
   constexpr double kSigmaA = 0.25, kLength = 2, kEnv = 0.2;
   const auto kelvin_at = [](double x) { return 1000 + 1000 * x; };
-  write_grids(dir.file("fire.vdb"),
-              {grid_of("heat", {-3, -3, -3}, {23, 13, 13},
-                       [&](int i, int, int) { return kelvin_at(i * kVoxel); })});
+  test::write_vdb(dir.file("fire.vdb"),
+                  {grid_of("heat", {-3, -3, -3}, {23, 13, 13},
+                           [&](int i, int, int) { return kelvin_at(i * kVoxel); })});
   const double s = 1 / planck_luminance(3000);
   const RenderResult r = render_file(
       dir, "gradient.json",
@@ -248,16 +236,11 @@ std::string load_error(const TempDir& dir, const std::string& emission) {
 TEST(TemperatureGridErrors, BadInputIsOneLineNamingTheJsonPathAndTheFile) {
   const TempDir dir("temperature_errors");
   const std::string at = dir.file("scene.json") + ": /media/m/emission";
-  write_grids(dir.file("smoke.vdb"),
-              {grid_of("density", {0, 0, 0}, {1, 1, 1}, [](int, int, int) { return 1; }),
-               grid_of("flames", {0, 0, 0}, {1, 1, 1}, [](int, int, int) { return 1; })});
-  openvdb::Vec3SGrid::Ptr vel = openvdb::Vec3SGrid::create();
-  vel->tree().setValueOn({0, 0, 0}, openvdb::Vec3s(1, 0, 0));
-  vel->setName("temperature");
-  write_grids(dir.file("vectors.vdb"), {vel});
-  auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(1.0f, {0, 0, 0}, 0.1f);
-  sphere->setName("temperature");
-  write_grids(dir.file("levelset.vdb"), {sphere});
+  test::write_vdb(dir.file("smoke.vdb"),
+                  {grid_of("density", {0, 0, 0}, {1, 1, 1}, [](int, int, int) { return 1; }),
+                   grid_of("flames", {0, 0, 0}, {1, 1, 1}, [](int, int, int) { return 1; })});
+  test::write_vec3s_vdb(dir.file("vectors.vdb"), "temperature", {0, 0, 0}, {1, 0, 0});
+  test::write_level_set_sphere_vdb(dir.file("levelset.vdb"), "temperature", 1.0, 0.1);
   std::ofstream(dir.file("text.vdb")) << "hot air\n";
 
   struct Case {

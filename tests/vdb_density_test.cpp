@@ -9,11 +9,6 @@
 #include "nimbus/media/vdb_density.h"
 
 #include <gtest/gtest.h>
-#include <nanovdb/util/IO.h>
-#include <nanovdb/util/OpenToNanoVDB.h>
-#include <openvdb/io/File.h>
-#include <openvdb/openvdb.h>
-#include <openvdb/tools/LevelSetSphere.h>
 
 #include <algorithm>
 #include <cmath>
@@ -47,11 +42,6 @@ DensityPtr vdb(const std::string& file, const Mat4& transform = Mat4::identity()
   p.file = file;
   p.transform = transform;
   return make_vdb_density(p);
-}
-
-void write_grids(const std::string& file, const openvdb::GridPtrVec& grids) {
-  openvdb::initialize();
-  openvdb::io::File(file).write(grids);
 }
 
 // Voxel size 0.1, index (0, 0, 0) at (1, -2, 0.5): voxels -4..20 active on every axis.
@@ -213,12 +203,11 @@ TEST(VdbDensity, RangeFromTheTreeHoldsEveryValueAndIsTight) {
 
   // A box inside one leaf's last voxels still reaches into the next leaf: the value at x = 7.5
   // blends voxels 7 and 8, and voxel 8 lies in the next leaf.
-  openvdb::FloatGrid::Ptr g = openvdb::FloatGrid::create(0.0f);
+  test::FloatGrid g{.name = "density"};
   for (int i = 0; i < 16; ++i)
     for (int j = 0; j < 4; ++j)
-      for (int k = 0; k < 4; ++k) g->tree().setValue({i, j, k}, i == 8 ? 9.0f : 1.0f);
-  g->setName("density");
-  write_grids(dir.file("step.vdb"), {g});
+      for (int k = 0; k < 4; ++k) g.voxels.push_back({{i, j, k}, i == 8 ? 9.0f : 1.0f});
+  test::write_vdb(dir.file("step.vdb"), {g});
   const DensityPtr step = vdb(dir.file("step.vdb"));
   const Interval r = step->range({{7.2, 1.2, 1.2}, {7.8, 1.8, 1.8}}, {1, 1});
   EXPECT_NEAR(step->value({7.5, 1.5, 1.5}, 1), 5.0, 1e-12);
@@ -234,20 +223,16 @@ TEST(VdbDensity, RangeFromTheTreeHoldsEveryValueAndIsTight) {
 // between them; everything else empty.
 TEST(VdbDensity, ASparseGridsEmptyTilesBoundToZeroAndCostNoLookup) {
   const TempDir dir("vdb_sparse");
-  openvdb::initialize();
-  openvdb::FloatGrid::Ptr g = openvdb::FloatGrid::create(0.0f);
-  auto acc = g->getAccessor();
+  test::FloatGrid g{.name = "density", .voxel = 1.0};
   for (int i = 0; i < 6; ++i)
     for (int j = 0; j < 6; ++j)
       for (int k = 0; k < 6; ++k) {
-        acc.setValue({i, j, k}, 0.5f + 0.1f * float(i));
-        acc.setValue({4000 + i, j, k}, 2.0f);
+        g.voxels.push_back({{i, j, k}, 0.5f + 0.1f * float(i)});
+        g.voxels.push_back({{4000 + i, j, k}, 2.0f});
       }
   // An active tile in an upper internal node (level 2): 128³ voxels of 0.25, no leaf.
-  g->tree().addTile(2, {1024, 0, 0}, 0.25f, true);
-  g->setName("density");
-  g->setTransform(openvdb::math::Transform::createLinearTransform(1.0));
-  write_grids(dir.file("sparse.vdb"), {g});
+  g.tiles.push_back({2, {1024, 0, 0}, 0.25f});
+  test::write_vdb(dir.file("sparse.vdb"), {g});
   const DensityPtr d = vdb(dir.file("sparse.vdb"));
 
   EXPECT_NEAR(d->value({2, 2, 2}, 1), 0.7, 1e-6);
@@ -301,11 +286,7 @@ TEST(VdbDensity, ASparseGridsEmptyTilesBoundToZeroAndCostNoLookup) {
 TEST(VdbDensity, NanoVdbFilesReadAsTheirOpenVdbFiles) {
   const TempDir dir("vdb_nano");
   test::write_ball_vdb(dir.file("ball.vdb"), 16, 0.05, {0.3, 0.1, -0.2});
-  openvdb::initialize();
-  openvdb::io::File in(dir.file("ball.vdb"));
-  in.open();
-  const auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(in.readGrid("density"));
-  nanovdb::io::writeGrid(dir.file("ball.nvdb"), nanovdb::openToNanoVDB(*grid));
+  test::write_nvdb(dir.file("ball.vdb"), dir.file("ball.nvdb"));
   const DensityPtr a = vdb(dir.file("ball.vdb")), b = vdb(dir.file("ball.nvdb"));
   Rng rng(6);
   for (int n = 0; n < 2000; ++n) {
@@ -319,13 +300,11 @@ TEST(VdbDensity, NanoVdbFilesReadAsTheirOpenVdbFiles) {
 
 TEST(VdbDensity, DoubleGridsInactiveAndNegativeValues) {
   const TempDir dir("vdb_double");
-  openvdb::initialize();
-  openvdb::DoubleGrid::Ptr g = openvdb::DoubleGrid::create(3.0);  // a background that is not 0
-  g->tree().setValueOn({0, 0, 0}, 2.0);
-  g->tree().setValueOn({1, 0, 0}, -1.0);  // negative: read as 0
-  g->tree().setValueOff({0, 1, 0}, 5.0);  // inactive: read as 0
-  g->setName("density");
-  write_grids(dir.file("double.vdb"), {g});
+  test::DoubleGrid g{.name = "density", .background = 3.0};  // a background that is not 0
+  g.active.push_back({{0, 0, 0}, 2.0});
+  g.active.push_back({{1, 0, 0}, -1.0});   // negative: read as 0
+  g.inactive.push_back({{0, 1, 0}, 5.0});  // inactive: read as 0
+  test::write_double_vdb(dir.file("double.vdb"), g);
   const DensityPtr d = vdb(dir.file("double.vdb"));
   EXPECT_EQ(d->value({0, 0, 0}, 1), 2.0);
   EXPECT_EQ(d->value({1, 0, 0}, 1), 0.0);
@@ -355,35 +334,24 @@ TEST(VdbDensity, BadInputIsOneLineNamingTheJsonPathAndTheFile) {
   const TempDir dir("vdb_errors");
   const std::string scene = dir.file("scene.json") + ": /media/m/density";
   const auto in_dir = [&](const std::string& name) { return dir.file(name); };
-  openvdb::initialize();
+  // A grid named `name` whose one voxel (0, 0, 0) holds 1.
+  const auto one_voxel = [](const std::string& name) {
+    return test::FloatGrid{.name = name, .voxels = {{{0, 0, 0}, 1.0f}}};
+  };
 
   // Two grids, neither named "density".
-  openvdb::FloatGrid::Ptr smoke = openvdb::FloatGrid::create(0.0f);
-  smoke->tree().setValueOn({0, 0, 0}, 1.0f);
-  smoke->setName("smoke");
-  openvdb::FloatGrid::Ptr temperature = smoke->deepCopy();
-  temperature->setName("temperature");
-  write_grids(in_dir("two.vdb"), {smoke, temperature});
+  test::write_vdb(in_dir("two.vdb"), {one_voxel("smoke"), one_voxel("temperature")});
   // A grid of vectors.
-  openvdb::Vec3SGrid::Ptr vel = openvdb::Vec3SGrid::create();
-  vel->tree().setValueOn({0, 0, 0}, openvdb::Vec3s(1, 0, 0));
-  vel->setName("density");
-  write_grids(in_dir("vectors.vdb"), {vel});
+  test::write_vec3s_vdb(in_dir("vectors.vdb"), "density", {0, 0, 0}, {1, 0, 0});
   // A level set.
-  auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(1.0f, {0, 0, 0}, 0.1f);
-  sphere->setName("density");
-  write_grids(in_dir("levelset.vdb"), {sphere});
+  test::write_level_set_sphere_vdb(in_dir("levelset.vdb"), "density", 1.0, 0.1);
   // A frustum transform.
-  openvdb::FloatGrid::Ptr frustum = smoke->deepCopy();
-  frustum->setName("density");
-  frustum->setTransform(openvdb::math::Transform::createFrustumTransform(
-      openvdb::BBoxd({0, 0, 0}, {10, 10, 10}), 0.5, 2.0));
-  write_grids(in_dir("frustum.vdb"), {frustum});
+  test::write_frustum_vdb(in_dir("frustum.vdb"), one_voxel("density"), {0, 0, 0}, {10, 10, 10}, 0.5,
+                          2.0);
   // A value that is not finite.
-  openvdb::FloatGrid::Ptr nan = smoke->deepCopy();
-  nan->setName("density");
-  nan->tree().setValueOn({1, 2, 3}, std::numeric_limits<float>::quiet_NaN());
-  write_grids(in_dir("nan.vdb"), {nan});
+  test::FloatGrid nan = one_voxel("density");
+  nan.voxels.push_back({{1, 2, 3}, std::numeric_limits<float>::quiet_NaN()});
+  test::write_vdb(in_dir("nan.vdb"), {nan});
   // Not VDB, and VDB cut short.
   std::ofstream(in_dir("text.vdb")) << "a cloud, honestly\n";
   test::write_ball_vdb(in_dir("ball.vdb"), 16, 0.1, {0, 0, 0});
@@ -391,17 +359,8 @@ TEST(VdbDensity, BadInputIsOneLineNamingTheJsonPathAndTheFile) {
   std::filesystem::copy_file(in_dir("ball.vdb"), in_dir("cut.vdb"));
   std::filesystem::resize_file(in_dir("cut.vdb"), bytes * 2 / 3);
   // NanoVDB cut short, and NanoVDB with a wild child offset.
-  {
-    openvdb::io::File f(in_dir("ball.vdb"));
-    f.open();
-    auto handle =
-        nanovdb::openToNanoVDB(*openvdb::gridPtrCast<openvdb::FloatGrid>(f.readGrid("density")));
-    nanovdb::io::writeGrid(in_dir("ball.nvdb"), handle);
-    auto* root = handle.grid<float>()->tree().root().data();
-    for (uint32_t i = 0; i < root->mTableSize; ++i)
-      if (root->tile(i)->isChild()) root->tile(i)->child = int64_t(1) << 40;
-    nanovdb::io::writeGrid(in_dir("wild.nvdb"), handle);
-  }
+  test::write_nvdb(in_dir("ball.vdb"), in_dir("ball.nvdb"));
+  test::write_nvdb_with_wild_children(in_dir("ball.vdb"), in_dir("wild.nvdb"));
   std::filesystem::copy_file(in_dir("ball.nvdb"), in_dir("cut.nvdb"));
   std::filesystem::resize_file(in_dir("cut.nvdb"),
                                std::filesystem::file_size(in_dir("ball.nvdb")) / 2);

@@ -7,12 +7,12 @@
 #include "nimbus/io/vdb_export.h"
 
 #include <gtest/gtest.h>
-#include <openvdb/io/File.h>
-#include <openvdb/openvdb.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -44,15 +44,11 @@ const char* kCloudScene = R"({
               {"shape": "blob", "medium": "cloud"}]
 })";
 
-openvdb::FloatGrid::Ptr read_density(const std::string& file,
-                                     openvdb::MetaMap::Ptr* meta = nullptr) {
-  openvdb::initialize();
-  openvdb::io::File f(file);
-  f.open();
-  if (meta) *meta = f.getMetadata();
-  EXPECT_EQ(f.getGrids()->size(), 1u);
-  auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(f.readGrid("density"));
-  EXPECT_NE(grid, nullptr);
+// The file's grid "density", which must be its only grid and hold floats.
+std::optional<test::ReadFloatGrid> read_density(const std::string& file) {
+  EXPECT_EQ(test::vdb_grid_names(file).size(), 1u);
+  std::optional<test::ReadFloatGrid> grid = test::read_float_grid(file, "density");
+  EXPECT_TRUE(grid.has_value());
   return grid;
 }
 
@@ -66,26 +62,24 @@ TEST(VdbExport, ActiveVoxelsHoldTheDensityAtVoxelCentres) {
   const VdbExportResult result = export_vdb(scene, object, h, dir.file("cloud.vdb"));
   EXPECT_FALSE(result.cancelled);
 
-  openvdb::MetaMap::Ptr file_meta;
-  const openvdb::FloatGrid::Ptr grid = read_density(dir.file("cloud.vdb"), &file_meta);
-  ASSERT_NE(grid, nullptr);
-  EXPECT_EQ(grid->getGridClass(), openvdb::GRID_FOG_VOLUME);
-  EXPECT_EQ(grid->background(), 0.0f);
-  EXPECT_TRUE(grid->transform().isLinear());
-  for (const openvdb::Coord ijk : {openvdb::Coord(0, 0, 0), openvdb::Coord(3, -7, 11)}) {
-    const openvdb::Vec3d w = grid->indexToWorld(ijk);
+  const std::optional<test::ReadFloatGrid> grid = read_density(dir.file("cloud.vdb"));
+  ASSERT_TRUE(grid.has_value());
+  EXPECT_EQ(grid->grid_class, test::GridClass::kFogVolume);
+  EXPECT_EQ(grid->background, 0.0f);
+  EXPECT_TRUE(grid->linear);
+  for (const test::Coord ijk : {test::Coord{0, 0, 0}, test::Coord{3, -7, 11}}) {
+    const Vec3 w = grid->index_to_world(ijk);
     for (int k = 0; k < 3; ++k) EXPECT_DOUBLE_EQ(w[k], ijk[k] * h);
   }
-  EXPECT_EQ(grid->metaValue<openvdb::Vec3s>("sigma_a"), openvdb::Vec3s(0.1f, 0.2f, 0.3f));
-  EXPECT_EQ(grid->metaValue<openvdb::Vec3s>("sigma_s"), openvdb::Vec3s(4, 5, 6));
-  EXPECT_EQ(grid->metaValue<float>("phase_g"), 0.6f);
-  EXPECT_EQ(file_meta->metaValue<std::string>("creator"), "nimbus " NIMBUS_VERSION);
+  EXPECT_EQ(grid->vec3s_metadata.at("sigma_a"), (std::array<float, 3>{0.1f, 0.2f, 0.3f}));
+  EXPECT_EQ(grid->vec3s_metadata.at("sigma_s"), (std::array<float, 3>{4, 5, 6}));
+  EXPECT_EQ(grid->float_metadata.at("phase_g"), 0.6f);
+  EXPECT_EQ(test::vdb_file_metadata(dir.file("cloud.vdb"), "creator"), "nimbus " NIMBUS_VERSION);
 
   // Every voxel centre in the object's bounds, against the medium's density there.
   const SceneObject& obj = scene.objects[object];
   const Medium& medium = scene.media[obj.medium];
   const float threshold = float(kVdbExportThreshold * result.max_density);
-  const auto acc = grid->getConstAccessor();
   uint64_t centres = 0, active = 0;
   double largest = 0;
   const auto first = [&](int axis) { return int(std::ceil(obj.bounds.lo[axis] / h)); };
@@ -98,22 +92,22 @@ TEST(VdbExport, ActiveVoxelsHoldTheDensityAtVoxelCentres) {
         const double F = evaluate(obj.tape, x);
         const double expected = F > 0 ? medium_density(medium, x, F) : 0.0;
         largest = std::max(largest, expected);
-        const openvdb::Coord ijk(i, j, k);
-        if (acc.isValueOn(ijk)) {
+        const test::Coord ijk{i, j, k};
+        if (grid->is_on(ijk)) {
           ++active;
-          ASSERT_EQ(acc.getValue(ijk), float(expected)) << i << " " << j << " " << k;
-          EXPECT_GE(acc.getValue(ijk), threshold);
+          ASSERT_EQ(grid->value(ijk), float(expected)) << i << " " << j << " " << k;
+          EXPECT_GE(grid->value(ijk), threshold);
         } else {
-          EXPECT_EQ(acc.getValue(ijk), 0.0f);
+          EXPECT_EQ(grid->value(ijk), 0.0f);
           EXPECT_LT(float(expected), threshold) << i << " " << j << " " << k;
         }
       }
-  EXPECT_EQ(active, grid->activeVoxelCount()) << "no active voxel outside the bounds";
+  EXPECT_EQ(active, grid->active_voxel_count) << "no active voxel outside the bounds";
   EXPECT_EQ(active, result.active_voxels);
   EXPECT_EQ(result.max_density, double(float(largest)));
   EXPECT_GT(active, centres / 10);
   EXPECT_LT(active, centres / 2) << "the file is sparse";
-  EXPECT_EQ(grid->tree().activeTileCount(), 0u);
+  EXPECT_EQ(grid->active_tile_count, 0u);
 }
 
 TEST(VdbExport, TheObjectIsChosenAsDocumented) {
@@ -268,12 +262,11 @@ TEST(VdbExport, TheShippedExampleIsTheExportOfItsSourceScene) {
   const auto shipped = read_density(scenes + "vdb/vdb_cloud.vdb");
   const auto fresh = read_density(dir.file("fresh.vdb"));
   ASSERT_TRUE(shipped && fresh);
-  EXPECT_EQ(shipped->activeVoxelCount(), fresh->activeVoxelCount());
-  EXPECT_EQ(shipped->voxelSize(), fresh->voxelSize());
-  const auto acc = fresh->getConstAccessor();
+  EXPECT_EQ(shipped->active_voxel_count, fresh->active_voxel_count);
+  EXPECT_EQ(shipped->voxel_size, fresh->voxel_size);
   uint64_t differ = 0;
-  for (auto v = shipped->cbeginValueOn(); v; ++v)
-    differ += !acc.isValueOn(v.getCoord()) || acc.getValue(v.getCoord()) != *v;
+  for (const auto& v : shipped->active)
+    differ += !fresh->is_on(v.ijk) || fresh->value(v.ijk) != v.value;
   EXPECT_EQ(differ, 0u) << "regenerate it with the command in scenes/vdb_cloud.json";
 
   Scene scene;

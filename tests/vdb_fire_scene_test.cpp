@@ -1,21 +1,23 @@
 // The shipped fire (scenes/vdb_fire.json, issue 14): its grids, "density" (soot) and
-// "temperature" (kelvin) in scenes/vdb/vdb_fire.vdb, are made here with OpenVDB's API and
-// written when NIMBUS_WRITE_SCENE_ASSETS=1. The test checks that the committed file holds what
-// the generator makes, voxel for voxel, and that the scene loads and renders light from the fire.
+// "temperature" (kelvin) in scenes/vdb/vdb_fire.vdb, are made here and written with OpenVDB's
+// API (support/vdb_grids.h) when NIMBUS_WRITE_SCENE_ASSETS=1. The test checks that the committed
+// file holds what the generator makes, voxel for voxel, and that the scene loads and renders
+// light from the fire.
 
 #include <gtest/gtest.h>
-#include <openvdb/io/File.h>
-#include <openvdb/openvdb.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "nimbus/render/renderer.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
+#include "support/vdb_grids.h"
 
 namespace nimbus {
 namespace {
@@ -50,46 +52,36 @@ FireSample fire_at(double x, double y, double z) {
   return s;
 }
 
-openvdb::GridPtrVec fire_grids() {
-  openvdb::initialize();
-  auto density = openvdb::FloatGrid::create(0.0f);
-  auto temperature = openvdb::FloatGrid::create(0.0f);
-  auto d = density->getAccessor();
-  auto k = temperature->getAccessor();
+std::vector<test::FloatGrid> fire_grids() {
+  test::FloatGrid density{
+      .name = "density", .voxel = kVoxel, .grid_class = test::GridClass::kFogVolume};
+  test::FloatGrid temperature{
+      .name = "temperature", .voxel = kVoxel, .grid_class = test::GridClass::kFogVolume};
   const int r = int(std::ceil(0.6 / kVoxel)), top = int(std::ceil(kHeight / kVoxel));
   for (int i = -r; i <= r; ++i)
     for (int j = 0; j <= top; ++j)
       for (int l = -r; l <= r; ++l) {
         const FireSample s = fire_at(i * kVoxel, j * kVoxel, l * kVoxel);
         if (s.density <= 0) continue;
-        d.setValueOn({i, j, l}, float(s.density));
-        k.setValueOn({i, j, l}, float(s.kelvin));
+        density.voxels.push_back({{i, j, l}, float(s.density)});
+        temperature.voxels.push_back({{i, j, l}, float(s.kelvin)});
       }
-  for (auto grid : {density, temperature}) {
-    grid->setTransform(openvdb::math::Transform::createLinearTransform(kVoxel));
-    grid->setGridClass(openvdb::GRID_FOG_VOLUME);
-  }
-  density->setName("density");
-  temperature->setName("temperature");
   return {density, temperature};
 }
 
 TEST(VdbFireScene, TheCommittedGridsAreTheGeneratorsAndTheSceneRendersFire) {
   const std::string file = kScenes + "vdb/vdb_fire.vdb";
-  openvdb::GridPtrVec made = fire_grids();
-  if (std::getenv("NIMBUS_WRITE_SCENE_ASSETS")) openvdb::io::File(file).write(made);
+  const std::vector<test::FloatGrid> made = fire_grids();
+  if (std::getenv("NIMBUS_WRITE_SCENE_ASSETS")) test::write_vdb(file, made);
   ASSERT_TRUE(std::filesystem::exists(file)) << file << " (NIMBUS_WRITE_SCENE_ASSETS=1 writes it)";
   EXPECT_LT(std::filesystem::file_size(file), 400u << 10);
-  openvdb::io::File f(file);
-  f.open();
-  for (const auto& base : made) {
-    const auto want = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
-    const auto have = openvdb::gridPtrCast<openvdb::FloatGrid>(f.readGrid(want->getName()));
-    ASSERT_TRUE(have) << want->getName();
-    EXPECT_EQ(have->activeVoxelCount(), want->activeVoxelCount()) << want->getName();
-    auto acc = have->getConstAccessor();
-    for (auto v = want->cbeginValueOn(); v; ++v)
-      ASSERT_EQ(acc.getValue(v.getCoord()), *v) << want->getName() << " " << v.getCoord();
+  for (const test::FloatGrid& want : made) {
+    const std::optional<test::ReadFloatGrid> have = test::read_float_grid(file, want.name);
+    ASSERT_TRUE(have) << want.name;
+    // The made grid's voxels are distinct, each active: their number is its active voxel count.
+    EXPECT_EQ(have->active_voxel_count, want.voxels.size()) << want.name;
+    for (const auto& v : want.voxels)
+      ASSERT_EQ(have->value(v.ijk), v.value) << want.name << " " << v.ijk;
   }
 
   SceneDesc desc = load_scene_file(kScenes + "vdb_fire.json");

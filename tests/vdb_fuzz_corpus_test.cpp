@@ -5,12 +5,7 @@
 // NIMBUS_WRITE_FUZZ_CORPUS=1 (re)writes it.
 
 #include <gtest/gtest.h>
-#include <nanovdb/util/IO.h>
-#include <nanovdb/util/OpenToNanoVDB.h>
-#include <openvdb/io/File.h>
-#include <openvdb/openvdb.h>
 
-#include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -51,21 +46,15 @@ void write_corpus() {
   fs::create_directories(kCorpus);
   test::write_linear_vdb(kCorpus + "linear8.vdb", 0, 7, 1.0, {-4, -4, -4});
   test::write_linear_vdb(kCorpus + "linear4.vdb", 0, 3, 2.0, {-4, -4, -4});
-  {
-    openvdb::io::File f(kCorpus + "linear8.vdb");
-    f.open();
-    const auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(f.readGrid("density"));
-    nanovdb::io::writeGrid(kCorpus + "linear8.nvdb", nanovdb::openToNanoVDB(*grid));
-  }
+  test::write_nvdb(kCorpus + "linear8.vdb", kCorpus + "linear8.nvdb");
   fs::resize_file(kCorpus + "linear8.nvdb", 16384);
   write_cut(kCorpus + "linear8.vdb", kCorpus + "linear8_cut_half.vdb", 0.5);
   write_cut(kCorpus + "linear8.vdb", kCorpus + "linear8_cut_90.vdb", 0.9);
   write_cut(kCorpus + "linear4.vdb", kCorpus + "linear4_cut_header.vdb", 0.1);
   // The fuzzer's first findings, fixed in vdb_file.cpp: a grid's name longer than the file, and
   // one without its terminating zero, which NanoVDB's header reader trusts.
-  const std::uint64_t name_size =
-      sizeof(nanovdb::io::Header) + offsetof(nanovdb::io::MetaData, nameSize);
-  const std::uint64_t name = sizeof(nanovdb::io::Header) + sizeof(nanovdb::io::MetaData);
+  const std::uint64_t name_size = test::nvdb_name_size_offset();
+  const std::uint64_t name = test::nvdb_name_offset();
   patch(kCorpus + "linear8.nvdb", kCorpus + "linear8_long_name.nvdb", name_size,
         {0xf0, 0xff, 0xff, 0xff});
   patch(kCorpus + "linear8.nvdb", kCorpus + "linear8_unterminated_name.nvdb", name + 7, {'x'});
