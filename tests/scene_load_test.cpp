@@ -1,4 +1,5 @@
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -13,6 +14,7 @@
 #include "nimbus/frep/primitives.h"
 #include "nimbus/media/cloud_density.h"
 #include "nimbus/media/field_density.h"
+#include "nimbus/render/wavelength_counts.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
 #include "nimbus/spectral/color.h"
@@ -297,8 +299,9 @@ std::vector<BadScene> bad_scenes() {
       {"too few wavelengths",
        with_camera(R"("spectrum": {"mode": "spectral", "wavelengths": 3})"),
        {},
-       "scene.json: /spectrum/wavelengths: must be one of 4, 8, 12, 16 (the counts this build "
-       "renders: CMake option NIMBUS_WAVELENGTH_COUNTS)"},
+       fmt::format("scene.json: /spectrum/wavelengths: must be one of {} (the counts this build "
+                   "renders: CMake option NIMBUS_WAVELENGTH_COUNTS)",
+                   fmt::join(built_wavelength_counts(), ", "))},
       {"sampled spectrum not increasing",
        with_medium(R"({"sigma_s": {"spectrum": [[400, 1], [700, 2], [650, 3]]}})"),
        {},
@@ -537,13 +540,13 @@ TEST(SceneLoad, ExampleLoads) {
 
 TEST(SceneLoad, SpectralModeAndSpectralColours) {
   const SceneDesc s = load(with_camera(R"(
-    "spectrum": {"mode": "spectral", "wavelengths": 12},
+    "spectrum": {"mode": "spectral", "wavelengths": 4},
     "lights": [{"type": "environment", "radiance": {"blackbody": 6500, "scale": 2}},
                {"type": "point", "position": [0, 1, 0], "intensity": [1, 0.5, 0.25]}],
     "media": {"jade": {"sigma_s": {"spectrum": [[400, 1], [550, 4], [700, 2]]},
                        "sigma_a": 0.1}})"));
   EXPECT_EQ(s.spectrum.mode, SpectralSettings::Mode::Spectral);
-  EXPECT_EQ(s.spectrum.wavelengths, 12);
+  EXPECT_EQ(s.spectrum.wavelengths, 4);  // not the default, 8
   // A blackbody keeps its curve; rgb mode gets its projection, of luminance `scale`.
   ASSERT_TRUE(s.lights[0].radiance.curve.has_value());
   EXPECT_EQ(s.lights[0].radiance.curve->type, SpectralCurve::Type::Blackbody);
