@@ -4,6 +4,6 @@
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 bash "$root/tools/setup.sh"
-cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
+bash "$root/tools/configure.sh" release
 cmake --build "$root/build" -j"$(nproc)" --target nimbus
 "$root/build/nimbus" render "$root/scenes/demo.json" -o demo.exr -o demo.png "$@"

@@ -27,8 +27,7 @@ if [ "${1:-}" = "--vdb" ]; then
   # whose reading threw (docs/testing.md).
   options=(-max_len=16384 -detect_leaks=0)
 fi
-CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DNIMBUS_SANITIZE=ON \
-  -DNIMBUS_BUILD_FUZZER=ON -DNIMBUS_BUILD_BENCH=OFF >/dev/null
+bash tools/configure.sh sanitize "$build"
 cmake --build "$build" -j"$(nproc)" --target "$target"
 mkdir -p "$build/fuzz-findings"
 # -timeout: an input that takes 20 s is a hang worth reporting; -rss_limit_mb: the same for

@@ -2,7 +2,8 @@
 # Installs the Debian packages nimbus needs. A no-op when they are present.
 set -euo pipefail
 packages=(
-  build-essential cmake pkg-config clang libclang-rt-14-dev
+  # Ninja and lld: the scripts' builds (tools/configure.sh)
+  build-essential cmake ninja-build lld pkg-config clang libclang-rt-14-dev
   libtbb-dev libopenexr-dev libpng-dev nlohmann-json3-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   # OpenVDB volumes: the library, NanoVDB, Boost.Iostreams for OpenVDB's CMake module, and
