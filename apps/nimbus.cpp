@@ -17,6 +17,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -140,6 +141,34 @@ Outcome check_memory(const nimbus::SceneDesc& desc, const RenderArgs& args) {
   return {};
 }
 
+// The files a run reads: the scene file and every file its description made the loader read.
+std::vector<nimbus::NamedFile> scene_inputs(const std::string& scene,
+                                            const nimbus::SceneDesc& desc) {
+  std::vector<nimbus::NamedFile> inputs = {{"the scene file", scene}};
+  for (const nimbus::InputFile& f : desc.inputs)
+    inputs.push_back({"the file of " + f.pointer, f.path});
+  return inputs;
+}
+
+// Refuses a render whose outputs would overwrite what it reads or each other (issue 29: --stats
+// s.json replaced the scene). --resume's file is read, and is written again by the later
+// checkpoints unless --checkpoint names another file.
+void check_render_files(const RenderArgs& args, const std::vector<std::string>& outputs,
+                        const nimbus::SceneDesc& desc) {
+  using nimbus::NamedFile;
+  std::vector<NamedFile> written, read = scene_inputs(args.scene, desc);
+  for (const std::string& out : outputs) written.push_back({"-o", out});
+  if (!args.stats.empty()) written.push_back({"--stats", args.stats});
+  if (!args.checkpoint.empty()) {
+    written.push_back({"--checkpoint", args.checkpoint});
+    if (!args.resume.empty() && !nimbus::same_file(args.resume, args.checkpoint))
+      read.push_back({"the checkpoint of --resume", args.resume});
+  } else if (!args.resume.empty()) {
+    written.push_back({"--resume (its later checkpoints)", args.resume});
+  }
+  nimbus::check_outputs_distinct(written, read);
+}
+
 // Under mpirun every rank runs each step and all agree on its outcome (cluster_agree): a
 // failure is printed once, by rank 0, and every rank exits with its code. Returns that code.
 int agree(const Cluster& cluster, const Outcome& mine) {
@@ -204,9 +233,14 @@ Outcome prepare(const RenderArgs& args, const Cluster& cluster, Prepared& p) {
   } catch (const SceneError& e) {
     return {kExitBadInput, e.what()};
   }
+  if (lead) try {
+      check_render_files(args, p.outputs, p.desc);
+    } catch (const std::exception& e) {
+      return {kExitBadInput, fmt::format("nimbus: {}", e.what())};
+    }
   if (lead && !args.resume.empty()) {
-    const std::string diff =
-        fingerprint_difference(p.resumed.fingerprint, render_fingerprint(args.scene, p.overrides));
+    const std::string diff = fingerprint_difference(
+        p.resumed.fingerprint, render_fingerprint(args.scene, p.overrides, p.desc.inputs));
     if (!diff.empty())
       return {kExitBadInput,
               fmt::format("nimbus: --resume {}: the checkpoint is of another scene or other "
@@ -348,20 +382,29 @@ int lead_render_job(const RenderArgs& args, const Cluster& cluster, const Prepar
   job.start =
       args.resume.empty() ? Film(scene.settings.width, scene.settings.height) : p.resumed.film;
   const uint64_t held_at_start = samples_held(job.start);
+  // Why the last checkpoint could not be saved; empty: it was, or none was due. Reported in the
+  // run's last line, never as written.
+  auto checkpoint_failure = std::make_shared<std::string>();
   if (!p.checkpoint.empty()) {
     Checkpoint header;
-    header.fingerprint = render_fingerprint(args.scene, p.overrides);
+    header.fingerprint = render_fingerprint(args.scene, p.overrides, p.desc.inputs);
     header.majorants = majorant_hash(scene);
     header.spp = scene.settings.spp;
     job.checkpoint_interval = args.checkpoint_interval > 0 ? args.checkpoint_interval : 60;
     // Units are short next to the interval, so checkpoints come on time.
     job.unit_seconds = std::min(job.unit_seconds, job.checkpoint_interval / 4);
-    job.checkpoint = [header, path = p.checkpoint](const Film& film) mutable {
+    job.checkpoint = [header, path = p.checkpoint, held_at_start,
+                      checkpoint_failure](const Film& film) mutable {
+      // Nothing rendered yet: the file would gain nothing, and a fresh render's checkpoint
+      // would replace an earlier one with an empty film.
+      if (samples_held(film) == held_at_start) return;
       header.film = film;
       try {
         save_checkpoint(header, path);
+        checkpoint_failure->clear();
       } catch (const std::exception& e) {
-        std::fprintf(stderr, "\nnimbus: warning: --checkpoint: %s; the render goes on\n", e.what());
+        *checkpoint_failure = e.what();
+        std::fprintf(stderr, "\nnimbus: warning: --checkpoint: %s (not saved)\n", e.what());
       }
     };
   }
@@ -374,6 +417,13 @@ int lead_render_job(const RenderArgs& args, const Cluster& cluster, const Prepar
   // film holds whole units only, and its image so far is written too.
   if (r.stopped && p.checkpoint.empty()) {
     std::fprintf(stderr, "nimbus: stopped by %s before the render finished; nothing written\n",
+                 signal_name(sig));
+    return 128 + sig;
+  }
+  // Stopped before a unit was done: the image so far would be the one at the start (empty for a
+  // fresh render) and replace an earlier good one.
+  if (r.stopped && samples_held(r.film) == held_at_start) {
+    std::fprintf(stderr, "nimbus: stopped by %s before a sample was rendered; nothing written\n",
                  signal_name(sig));
     return 128 + sig;
   }
@@ -394,12 +444,26 @@ int lead_render_job(const RenderArgs& args, const Cluster& cluster, const Prepar
     return failed;
   const double total = double(scene.settings.width) * scene.settings.height * scene.settings.spp;
   if (r.stopped) {
-    std::fprintf(stderr,
-                 "nimbus: stopped by %s at %.1f%% of the samples; wrote the image so far to %s "
-                 "and the checkpoint %s (continue with --resume %s)\n",
-                 signal_name(sig), 100 * double(held) / total, joined(p.outputs).c_str(),
-                 p.checkpoint.c_str(), p.checkpoint.c_str());
+    if (checkpoint_failure->empty())
+      std::fprintf(stderr,
+                   "nimbus: stopped by %s at %.1f%% of the samples; wrote the image so far to %s "
+                   "and the checkpoint %s (continue with --resume %s)\n",
+                   signal_name(sig), 100 * double(held) / total, joined(p.outputs).c_str(),
+                   p.checkpoint.c_str(), p.checkpoint.c_str());
+    else
+      std::fprintf(stderr,
+                   "nimbus: stopped by %s at %.1f%% of the samples; wrote the image so far to %s; "
+                   "the checkpoint was not saved (%s)\n",
+                   signal_name(sig), 100 * double(held) / total, joined(p.outputs).c_str(),
+                   checkpoint_failure->c_str());
     return 128 + sig;
+  }
+  if (!checkpoint_failure->empty()) {
+    std::fprintf(stderr,
+                 "nimbus: wrote %s; the last checkpoint was not saved (%s): the render cannot be "
+                 "continued from it\n",
+                 joined(p.outputs).c_str(), checkpoint_failure->c_str());
+    return kExitFailure;
   }
   if (!args.quiet) {
     const double samples = double(held - held_at_start);
@@ -551,6 +615,12 @@ int run_export_vdb(const ExportArgs& args) {
   int object = -1;
   try {
     SceneDesc desc = load_scene_file(args.scene, args.sets);
+    try {
+      check_outputs_distinct({{"-o", args.output}}, scene_inputs(args.scene, desc));
+    } catch (const std::runtime_error& e) {
+      std::fprintf(stderr, "nimbus: %s\n", e.what());
+      return kExitBadInput;
+    }
     object = vdb_export_object(desc, args.object);
     // The export needs the objects' functions and media, not the renderer's majorants.
     desc.integrator.tracking.octree_depth = 0;

@@ -4,9 +4,14 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <thread>
+#include <utility>
+#include <vector>
 
 #include "nimbus/job/checkpoint.h"
 #include "support/process.h"
@@ -152,6 +157,135 @@ TEST_F(Checkpoints, ACheckpointOfOtherSettingsIsRefused) {
   EXPECT_FALSE(fs::exists(dir_ / "b.exr"));
   // Threads, outputs and spp change no pixel's samples: accepted.
   EXPECT_EQ(nimbus("--resume ck.nck --spp 3 --threads 1 -o c.png").code, 0);
+}
+
+// Issue 29: an output named like an input or like another output destroyed it (--stats s.json
+// replaced the scene; --checkpoint m.exr -o m.exr lost the checkpoint). Each is refused before
+// anything is rendered, with exit 2 and one line, and every file keeps its bytes.
+TEST_F(Checkpoints, OutputsThatWouldOverwriteAnInputOrEachOtherAreRefused) {
+  ASSERT_EQ(nimbus("--spp 1 --checkpoint ck.nck -o m.exr").code, 0);
+  fs::copy_file(fs::path(NIMBUS_SOURCE_DIR) / "scenes/vdb/vdb_cloud.vdb", dir_ / "grid.vdb");
+  std::ofstream(dir_ / "grid.json") << R"({
+    "film": {"width": 8, "height": 8},
+    "camera": {"type": "perspective", "from": [0, 0, 6], "to": [0, 0, 0], "fov": 35},
+    "lights": [{"type": "environment", "radiance": 1}],
+    "media": {"cloud": {"sigma_s": 2, "density": {"type": "vdb", "file": "grid.vdb"}}},
+    "objects": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "medium": "cloud"}]
+  })";
+  std::map<std::string, std::string> before;
+  for (const char* f : {"scene.json", "ck.nck", "m.exr", "grid.vdb", "grid.json"})
+    before[f] = file_bytes(dir_ / f);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"render scene.json -o m.exr --stats scene.json",
+       "--stats scene.json: is the scene file (scene.json), which the run reads"},
+      {"render scene.json -o m.exr --stats m.exr",
+       "--stats m.exr: is also the output of -o (m.exr)"},
+      {"render scene.json -o a.exr --checkpoint ck.nck --stats ck.nck",
+       "--checkpoint ck.nck: is also the output of --stats (ck.nck)"},
+      {"render scene.json -o a.exr --checkpoint scene.json",
+       "--checkpoint scene.json: is the scene file (scene.json), which the run reads"},
+      {"render scene.json -o m.exr --checkpoint m.exr",
+       "--checkpoint m.exr: is also the output of -o (m.exr)"},
+      {"render scene.json -o m.exr -o ./m.exr", "-o ./m.exr: is also the output of -o (m.exr)"},
+      {"render scene.json -o a.exr --resume ck.nck --stats ck.nck",
+       "--resume (its later checkpoints) ck.nck: is also the output of --stats (ck.nck)"},
+      {"render scene.json -o a.exr --resume ck.nck --checkpoint b.nck --stats ck.nck",
+       "--stats ck.nck: is the checkpoint of --resume (ck.nck), which the run reads"},
+      {"render grid.json -o a.exr --stats grid.vdb",
+       "--stats grid.vdb: is the file of /media/cloud/density/file (grid.vdb), which the run "
+       "reads"},
+      {"export-vdb grid.json -o grid.vdb --voxel-size 0.1",
+       "-o grid.vdb: is the file of /media/cloud/density/file (grid.vdb), which the run reads"},
+  };
+  for (const auto& [args, problem] : cases) {
+    const Ran r = run_nimbus_in(dir_, args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(r.err, "nimbus: " + problem + "\n") << args;
+    EXPECT_FALSE(fs::exists(dir_ / "a.exr")) << args;
+    EXPECT_FALSE(fs::exists(dir_ / "b.nck")) << args;
+    for (const auto& [f, bytes] : before)
+      EXPECT_EQ(file_bytes(dir_ / f), bytes) << args << ": " << f;
+  }
+  // Resuming into the checkpoint it reads is what --resume does.
+  EXPECT_EQ(nimbus("--resume ck.nck --spp 2 -o m.exr").code, 0);
+}
+
+// Issue 29: a damaged checkpoint was resumed. One byte changed is refused, naming the file.
+TEST_F(Checkpoints, ADamagedCheckpointIsNotResumed) {
+  ASSERT_EQ(nimbus("--spp 2 --checkpoint ck.nck -o a.exr").code, 0);
+  std::string bytes = file_bytes(dir_ / "ck.nck");
+  bytes[bytes.size() - 200] = char(bytes[bytes.size() - 200] ^ 0x10);  // in a pixel's record
+  std::ofstream(dir_ / "ck.nck", std::ios::binary | std::ios::trunc) << bytes;
+  const Ran r = nimbus("--resume ck.nck -o b.exr");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err,
+            "nimbus: --resume: ck.nck: the checkpoint is damaged or cut short (its checksum does "
+            "not match)\n");
+  EXPECT_FALSE(fs::exists(dir_ / "b.exr"));
+}
+
+// A render of about 1.3 s (Release, one thread) with checkpoints into sub/, whose folder is
+// removed once the first checkpoint is there (as a full disk would fail them), then, with
+// `signal`, stopped 0.2 s later: the shell's report of its exit code, and its stderr.
+Ran render_losing_its_checkpoint_folder(const fs::path& dir, const std::string& signal) {
+  const std::string nimbus = std::string("'") + NIMBUS_BINARY + "'";
+  // One subshell, so that all of it runs in `dir`.
+  const Ran r =
+      run_in(dir, "(" + nimbus +
+                      " render scene.json -q --spp 1000 --threads 1 --checkpoint sub/ck.nck "
+                      "--checkpoint-interval 0.05 -o out.exr 2>render.err & pid=$!; "
+                      "for i in $(seq 6000); do [ -e sub/ck.nck ] && break; sleep 0.01; done; "
+                      "rm -rf ./sub; " +
+                      (signal.empty() ? "" : "sleep 0.2; kill -" + signal + " $pid; ") +
+                      "wait $pid; echo $?)");
+  return {std::stoi(r.out), file_bytes(dir / "render.err"), ""};
+}
+
+// Issue 29: a checkpoint that could not be written was reported as written, and a render whose
+// last checkpoint failed ended with exit 0.
+TEST_F(Checkpoints, ACheckpointThatCouldNotBeSavedIsNeverReportedAsSaved) {
+  fs::create_directory(dir_ / "sub");
+  const Ran stopped = render_losing_its_checkpoint_folder(dir_, "INT");
+  EXPECT_EQ(stopped.code, 130) << stopped.err;
+  EXPECT_NE(
+      stopped.err.find("wrote the image so far to out.exr; the checkpoint was not saved (sub/"),
+      std::string::npos)
+      << stopped.err;
+  EXPECT_EQ(stopped.err.find("continue with --resume"), std::string::npos) << stopped.err;
+  EXPECT_TRUE(fs::exists(dir_ / "out.exr"));
+
+  fs::remove(dir_ / "out.exr");
+  fs::create_directory(dir_ / "sub");
+  const Ran ended = render_losing_its_checkpoint_folder(dir_, "");
+  EXPECT_EQ(ended.code, 1) << ended.err;
+  EXPECT_NE(ended.err.find("nimbus: wrote out.exr; the last checkpoint was not saved (sub/"),
+            std::string::npos)
+      << ended.err;
+  EXPECT_TRUE(fs::exists(dir_ / "out.exr"));
+}
+
+// Issue 29: SIGINT before the first unit was done replaced a good out.exr with an empty image
+// (and the checkpoint with an empty one). A camera inside a white medium of optical radius 300,
+// whose paths take about 28 ms each (Release) and whose first unit, 8 rows of 32 pixels, about
+// 7 s, is stopped 0.5 s after its start: nothing is written.
+TEST_F(Checkpoints, AStopBeforeTheFirstSampleWritesNothing) {
+  ASSERT_EQ(nimbus("--spp 1 --checkpoint ck.nck -o out.exr").code, 0);
+  const std::string image = file_bytes(dir_ / "out.exr"), checkpoint = file_bytes(dir_ / "ck.nck");
+  std::ofstream(dir_ / "white.json") << R"({
+    "film": {"width": 32, "height": 32},
+    "camera": {"type": "perspective", "from": [0, 0, 0], "to": [0, 0, -1], "fov": 35},
+    "integrator": {"spp": 1, "max_depth": 1000000},
+    "lights": [{"type": "environment", "radiance": 1}],
+    "media": {"milk": {"sigma_s": 60}},
+    "objects": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 5}, "medium": "milk"}]
+  })";
+  const pid_t pid = spawn_in(dir_, {NIMBUS_BINARY, "render", "white.json", "-q", "--threads", "1",
+                                    "--checkpoint", "ck.nck", "-o", "out.exr"});
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  ASSERT_EQ(::kill(pid, SIGINT), 0);
+  EXPECT_EQ(wait_for(pid), 130);
+  EXPECT_TRUE(file_bytes(dir_ / "out.exr") == image) << "out.exr was replaced";
+  EXPECT_TRUE(file_bytes(dir_ / "ck.nck") == checkpoint) << "ck.nck was replaced";
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "nimbus/job/film_patch.h"
 #include "nimbus/job/fingerprint.h"
 #include "nimbus/job/work_queue.h"
+#include "nimbus/scene/load.h"
 
 namespace nimbus {
 namespace {
@@ -159,6 +160,51 @@ TEST(Checkpoint, SavedAndLoadedBitForBit) {
   std::filesystem::remove(path);
 }
 
+// Issue 29: one byte of a pixel's record flipped was resumed (an image mean of -5e12), a sample
+// count set to 0 silently doubled a pixel. Any byte changed, or the file cut short, is refused.
+TEST(Checkpoint, ADamagedOrShortenedFileIsRefused) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("nimbus_ckdmg_" + std::to_string(::getpid())))
+          .string();
+  Checkpoint c;
+  c.fingerprint = {{"scene", {{"film", {{"width", 7}}}}}};
+  c.spp = 24;
+  c.film = numbered_film(7, 5);
+  save_checkpoint(c, path);
+  std::string good;
+  {
+    std::ifstream in(path, std::ios::binary);
+    good.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const std::string damaged =
+      path + ": the checkpoint is damaged or cut short (its checksum does not match)";
+  // After the magic and the version: the spp, the fingerprint, the film's pixels (a count, a
+  // sum), the checksum itself.
+  int refused = 0;
+  for (size_t at = 12; at < good.size(); at += 7) {
+    for (const unsigned char flip : {0x01, 0x80}) {
+      std::string bad = good;
+      bad[at] = char(bad[at] ^ flip);
+      std::ofstream(path, std::ios::binary | std::ios::trunc) << bad;
+      try {
+        load_checkpoint(path);
+        ADD_FAILURE() << "byte " << at << " changed, and the checkpoint was read";
+      } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()), damaged) << "byte " << at;
+        ++refused;
+      }
+    }
+  }
+  EXPECT_GT(refused, 2 * 7 * 5 * 2);  // more than two per pixel record of 76 bytes
+  for (const size_t cut : {size_t(1), size_t(4), size_t(80), good.size() - 13}) {
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << good.substr(0, good.size() - cut);
+    EXPECT_THROW(load_checkpoint(path), std::runtime_error) << cut << " bytes cut";
+  }
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << good;
+  EXPECT_EQ(load_checkpoint(path).film.samples, c.film.samples);
+  std::filesystem::remove(path);
+}
+
 TEST(Fingerprint, NamesTheFirstSettingThatDiffers) {
   const nlohmann::json a = {{"scene", {{"integrator", {{"seed", 1}}}, {"film", {{"width", 8}}}}}};
   nlohmann::json b = a;
@@ -172,21 +218,33 @@ TEST(Fingerprint, NamesTheFirstSettingThatDiffers) {
 }
 
 // A resumed render must read the same grids: the fingerprint holds their files' hashes.
-TEST(Fingerprint, HoldsTheFilesTheMediaRead) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("nimbus_fp_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
+// The files are those the loader recorded as it read them (issue 25: the fingerprint guessed
+// them from the JSON, one level under each medium): a density grid and a temperature grid.
+TEST(Fingerprint, HoldsEveryFileTheLoaderRead) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("nimbus_fp_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path vdb = fs::path(NIMBUS_SOURCE_DIR) / "scenes/vdb";
+  fs::copy_file(vdb / "vdb_fire.vdb", dir / "fire.vdb");
+  fs::copy_file(vdb / "vdb_fire.vdb", dir / "heat.vdb");
   std::ofstream(dir / "scene.json") << R"({"integrator": {"spp": 4, "seed": 2},
-    "media": {"m": {"density": {"type": "vdb", "file": "g.vdb"}}}})";
-  std::ofstream(dir / "g.vdb") << "grid one";
+    "camera": {"type": "perspective", "from": [0, 0, 5], "to": [0, 0, 0], "fov": 30},
+    "media": {"m": {"sigma_a": 1, "density": {"type": "vdb", "file": "fire.vdb"},
+                    "emission": {"file": "heat.vdb"}}},
+    "objects": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "medium": "m"}]})";
   const std::string scene = (dir / "scene.json").string();
-  const nlohmann::json before = render_fingerprint(scene, {"integrator.spp=8"});
-  EXPECT_EQ(fingerprint_difference(before, render_fingerprint(scene, {"integrator.spp=24"})), "");
-  std::ofstream(dir / "g.vdb") << "grid two";
-  const std::string d = fingerprint_difference(before, render_fingerprint(scene, {}));
+  const auto fingerprint = [&](const std::vector<std::string>& overrides) {
+    return render_fingerprint(scene, overrides, load_scene_file(scene, overrides).inputs);
+  };
+  const nlohmann::json before = fingerprint({"integrator.spp=8"});
+  EXPECT_EQ(before["files"].size(), 2u) << before["files"];
+  EXPECT_EQ(fingerprint_difference(before, fingerprint({"integrator.spp=24"})), "");
+  EXPECT_NE(fingerprint_difference(before, fingerprint({"integrator.seed=3"})), "");
+  // The grid of another scene, with the name this one reads.
+  fs::copy_file(vdb / "vdb_cloud.vdb", dir / "fire.vdb", fs::copy_options::overwrite_existing);
+  const std::string d = fingerprint_difference(before, fingerprint({}));
   EXPECT_EQ(d.rfind("files./media/m/density/file: ", 0), 0u) << d;
-  EXPECT_NE(fingerprint_difference(before, render_fingerprint(scene, {"integrator.seed=3"})), "");
-  std::filesystem::remove_all(dir);
+  fs::remove_all(dir);
 }
 
 }  // namespace

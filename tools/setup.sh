@@ -4,7 +4,7 @@ set -euo pipefail
 packages=(
   # Ninja and lld: the scripts' builds (tools/configure.sh)
   build-essential cmake ninja-build lld pkg-config clang libclang-rt-14-dev
-  libtbb-dev libopenexr-dev libpng-dev nlohmann-json3-dev libcli11-dev libfmt-dev
+  libtbb-dev libopenexr-dev libpng-dev zlib1g-dev nlohmann-json3-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   # OpenVDB volumes: the library, NanoVDB, Boost.Iostreams for OpenVDB's CMake module, and
   # vdb_print, which the tests run on exported files

@@ -1,5 +1,6 @@
 #include "nimbus/io/output.h"
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -60,6 +61,30 @@ void check_writable_path(const std::string& path) {
                                " (a folder of devices and kernel files)");
   if (fs::exists(path, ec) && !fs::is_regular_file(path, ec))
     throw std::runtime_error(path + ": exists and is not a regular file");
+}
+
+bool same_file(const std::string& a, const std::string& b) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec);
+  const fs::path ca = fs::weakly_canonical(fs::absolute(a, ec), ec);
+  const fs::path cb = fs::weakly_canonical(fs::absolute(b, ec), ec);
+  return ca == cb;
+}
+
+void check_outputs_distinct(const std::vector<NamedFile>& outputs,
+                            const std::vector<NamedFile>& inputs) {
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    const NamedFile& out = outputs[i];
+    for (const NamedFile& in : inputs)
+      if (same_file(out.path, in.path))
+        throw std::runtime_error(fmt::format("{} {}: is {} ({}), which the run reads", out.what,
+                                             out.path, in.what, in.path));
+    for (size_t j = 0; j < i; ++j)
+      if (same_file(out.path, outputs[j].path))
+        throw std::runtime_error(fmt::format("{} {}: is also the output of {} ({})", out.what,
+                                             out.path, outputs[j].what, outputs[j].path));
+  }
 }
 
 }  // namespace nimbus

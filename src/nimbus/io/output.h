@@ -3,6 +3,7 @@
 // a long render rather than after it.
 
 #include <string>
+#include <vector>
 
 #include "nimbus/io/image.h"
 
@@ -20,5 +21,21 @@ void check_output_path(const std::string& path);
 // The same check for a file of any kind: the directory exists and is writable, and the path is
 // not itself a directory.
 void check_writable_path(const std::string& path);
+
+// A file that a run reads or writes, with what named it: "-o", "--stats", "the scene file",
+// a JSON pointer in the scene.
+struct NamedFile {
+  std::string what;
+  std::string path;
+};
+
+// Whether two paths name one file: the same device and inode where both exist, else the same
+// absolute path once the links along it that exist are resolved.
+bool same_file(const std::string& a, const std::string& b);
+
+// Throws std::runtime_error("WHAT PATH: problem") for the first output that is one of the inputs
+// or an earlier output, which writing it would destroy or overwrite.
+void check_outputs_distinct(const std::vector<NamedFile>& outputs,
+                            const std::vector<NamedFile>& inputs);
 
 }  // namespace nimbus

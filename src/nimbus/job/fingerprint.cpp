@@ -72,27 +72,17 @@ std::string difference(const nlohmann::json& a, const nlohmann::json& b, const s
 }  // namespace
 
 nlohmann::json render_fingerprint(const std::string& scene_path,
-                                  const std::vector<std::string>& overrides) {
+                                  const std::vector<std::string>& overrides,
+                                  const std::vector<InputFile>& inputs) {
   std::ifstream in(scene_path, std::ios::binary);
   const std::string text((std::istreambuf_iterator<char>(in)), {});
   nlohmann::json scene = nlohmann::json::parse(text, nullptr, true, true);
   for (const std::string& o : overrides) apply_override(scene, o);
   if (scene.contains("integrator") && scene["integrator"].is_object())
     scene["integrator"].erase("spp");
-  // The files a medium reads (a "vdb" density's grid, an emission grid): every "file" string of
-  // an object inside a medium, relative to the scene file's folder.
+  // Each file under the JSON pointer that named it, as the loader recorded it.
   nlohmann::json files = nlohmann::json::object();
-  if (scene.contains("media") && scene["media"].is_object())
-    for (const auto& [name, medium] : scene["media"].items()) {
-      if (!medium.is_object()) continue;
-      for (const auto& [key, part] : medium.items())
-        if (part.is_object() && part.contains("file") && part["file"].is_string()) {
-          const std::filesystem::path file = part["file"].get<std::string>();
-          const std::filesystem::path full =
-              file.is_absolute() ? file : std::filesystem::path(scene_path).parent_path() / file;
-          files["/media/" + name + "/" + key + "/file"] = fmt::format("{:016x}", hash_file(full));
-        }
-    }
+  for (const InputFile& f : inputs) files[f.pointer] = fmt::format("{:016x}", hash_file(f.path));
   return {{"nimbus", NIMBUS_VERSION}, {"scene", scene}, {"files", files}};
 }
 

@@ -48,6 +48,7 @@ DensityPtr read_vdb(JsonObject& d) {
   if (transform) p.transform = read_transform(*transform);
   // A misspelt key is reported as such before the file is read with a default in its place.
   d.finish(R"(for density type "vdb")");
+  file.record_input(p.file);
   try {
     return make_vdb_density(p);
   } catch (const VdbError& e) {

@@ -28,6 +28,7 @@ std::shared_ptr<const TemperatureEmission> read_emission_grid(const JsonValue& v
   if (transform) p.transform = read_transform(*transform);
   // A misspelt key is reported before the file is read with a default in its place.
   o.finish("for a temperature grid's emission");
+  file.record_input(p.file);
   try {
     return make_temperature_emission(p, s);
   } catch (const VdbError& e) {

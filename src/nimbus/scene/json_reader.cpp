@@ -87,6 +87,10 @@ void JsonValue::fail(std::string_view problem) const {
   throw SceneError(fmt::format("{}: {}: {}", origin, pointer_.empty() ? "/" : pointer_, problem));
 }
 
+void JsonValue::record_input(const std::string& path) const {
+  if (origin_->inputs) origin_->inputs->push_back({pointer_, path});
+}
+
 void JsonValue::check(double x, const Range& range) const {
   if (!contains(range, x)) fail(describe(range));
 }

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "nimbus/math/vec3.h"
+#include "nimbus/scene/input_file.h"
 #include "nimbus/spectral/spectrum.h"
 
 namespace nimbus {
@@ -36,6 +37,9 @@ struct JsonOrigin {
   // The folder that relative file names in the document resolve against: the scene file's own;
   // "" (the current directory) for a document that is not a file.
   std::string folder = "";
+  // Where the loader records each file it reads, as it reads it (SceneDesc::inputs); none: not
+  // recorded.
+  std::vector<InputFile>* inputs = nullptr;
 };
 
 // An allowed interval for numbers; each end may be open, closed or absent.
@@ -65,6 +69,8 @@ class JsonValue {
   const nlohmann::json& json() const { return *json_; }
   const std::string& pointer() const { return pointer_; }
   const JsonOrigin& origin() const { return *origin_; }
+  // Records that this value, a file name, made the loader read `path` (JsonOrigin::inputs).
+  void record_input(const std::string& path) const;
 
   // Throws SceneError("ORIGIN: POINTER: problem").
   [[noreturn]] void fail(std::string_view problem) const;

@@ -642,10 +642,13 @@ namespace {
 // that is not a file.
 SceneDesc load_json_in(nlohmann::json j, const std::string& source, const std::string& folder,
                        const std::vector<std::string>& overrides) {
-  JsonOrigin origin{source, {}, folder};
+  std::vector<InputFile> inputs;
+  JsonOrigin origin{source, {}, folder, &inputs};
   for (const std::string& o : overrides)
     origin.overrides.push_back({apply_override(j, o), set_flag(o)});
-  return Loader(JsonValue(j, "", origin)).load();
+  SceneDesc scene = Loader(JsonValue(j, "", origin)).load();
+  scene.inputs = std::move(inputs);
+  return scene;
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "nimbus/media/density.h"
 #include "nimbus/media/temperature_emission.h"
 #include "nimbus/render/scene.h"
+#include "nimbus/scene/input_file.h"
 #include "nimbus/spectral/spectral_param.h"
 
 namespace nimbus {
@@ -97,6 +98,9 @@ struct SceneDesc {
   std::vector<LightDesc> lights;
   std::vector<MediumDesc> media;
   std::vector<ObjectDesc> objects;
+  // Every file the description made the loader read, in the order read (not the scene file
+  // itself): what a render's outputs must not overwrite.
+  std::vector<InputFile> inputs;
 };
 
 }  // namespace nimbus
