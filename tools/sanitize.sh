@@ -6,7 +6,7 @@
 #   tools/sanitize.sh         the CI tier: the suite less the repeats below
 #   tools/sanitize.sh --all   every test that can run under the sanitizers
 #
-# The GoogleTest binary runs in 8 shards (tools/gtest_shards.sh) rather than a process per test
+# The GoogleTest binary runs in 16 shards (tools/gtest_shards.sh) rather than a process per test
 # (one start costs 0.2 s of CPU under the sanitizers); the scripted tests run under ctest.
 # Never run here: the packaging test (the example it builds is not instrumented) and the image
 # checksums (recorded from the Release g++ build, which a clang build need not match to the last
@@ -28,7 +28,7 @@ filter="*:-$repeats"
 [ "${1:-}" = "--all" ] && filter='*'
 sanitized_tests() {
   ctest --test-dir build-sanitize --output-on-failure -j"$(nproc)" -LE gtest -E "$never"
-  bash tools/gtest_shards.sh build-sanitize/nimbus_tests "$(nproc)" 8 "$filter"
+  bash tools/gtest_shards.sh build-sanitize/nimbus_tests "$(nproc)" 16 "$filter"
 }
 phase "sanitized configure" bash tools/configure.sh sanitize
 phase "sanitized build" cmake --build build-sanitize -j"$(nproc)"
