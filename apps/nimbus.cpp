@@ -18,6 +18,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -47,10 +48,10 @@ struct RenderArgs {
   std::vector<std::string> outputs;
   std::vector<std::string> sets;
   int spp = 0;
-  long long seed = -1;
+  std::optional<uint64_t> seed;
   int threads = 0;
   std::string stats;
-  std::string max_memory;  // empty: the system's available memory
+  std::optional<std::string> max_memory;  // none: the system's available memory
   bool quiet = false;
   std::string checkpoint;
   double checkpoint_interval = 0;  // 0: not given (60 s)
@@ -122,8 +123,8 @@ Outcome check_memory(const nimbus::SceneDesc& desc, const RenderArgs& args) {
   std::uint64_t limit = 0;
   std::string source = "available";
   try {
-    if (!args.max_memory.empty()) {
-      limit = parse_memory_size(args.max_memory);
+    if (args.max_memory) {
+      limit = parse_memory_size(*args.max_memory);
       source = "allowed by --max-memory";
     } else {
       limit = available_memory();
@@ -174,9 +175,11 @@ void check_render_files(const RenderArgs& args, const std::vector<std::string>& 
 int agree(const Cluster& cluster, const Outcome& mine) {
   const ClusterFailure f = cluster_agree(mine.code, mine.message);
   if (f.code != 0 && cluster.rank == 0)
-    std::fprintf(stderr, "%s\n",
-                 f.rank == 0 ? f.message.c_str()
-                             : fmt::format("nimbus: rank {}: {}", f.rank, f.message).c_str());
+    std::fprintf(
+        stderr, "%s\n",
+        nimbus::printable_line(f.rank == 0 ? f.message
+                                           : fmt::format("nimbus: rank {}: {}", f.rank, f.message))
+            .c_str());
   return f.code;
 }
 
@@ -214,7 +217,7 @@ Outcome prepare(const RenderArgs& args, const Cluster& cluster, Prepared& p) {
   if (!args.resume.empty()) spp = int(cluster_broadcast(uint64_t(spp)));
   if (resume_failed.code != 0) return resume_failed;
   if (spp > 0) p.overrides.push_back(fmt::format("integrator.spp={}", spp));
-  if (args.seed >= 0) p.overrides.push_back(fmt::format("integrator.seed={}", args.seed));
+  if (args.seed) p.overrides.push_back(fmt::format("integrator.seed={}", *args.seed));
 
   p.outputs = args.outputs;
   if (p.outputs.empty()) {
@@ -696,6 +699,24 @@ CLI::Validator integer_in(long long lo, long long hi = std::numeric_limits<int>:
       fmt::format("INT >= {}", lo));
 }
 
+// A whole number in [0, 2^64 - 1], the range of the scene file's integrator.seed (issue 29: the
+// command line stopped at 2^63 - 1).
+CLI::Validator unsigned_64() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        const bool digits = !value.empty() && value.size() <= 20 &&
+                            value.find_first_not_of("0123456789") == std::string::npos;
+        if (!digits) return fmt::format("must be a whole number, not \"{}\"", value);
+        try {
+          std::stoull(value);
+        } catch (const std::out_of_range&) {
+          return fmt::format("must be <= {}, not {}", std::numeric_limits<uint64_t>::max(), value);
+        }
+        return {};
+      },
+      "UINT64");
+}
+
 // A number of seconds > 0, with the check said in words, as integer_in does.
 CLI::Validator positive_seconds() {
   return CLI::Validator(
@@ -729,7 +750,7 @@ int run_command(int argc, char** argv, const Cluster& cluster) {
   render->add_option("--spp", args.spp, "Samples per pixel (overrides integrator.spp)")
       ->check(integer_in(1));
   render->add_option("--seed", args.seed, "Random seed (overrides integrator.seed)")
-      ->check(integer_in(0, std::numeric_limits<long long>::max()));
+      ->check(unsigned_64());
   render->add_option("--threads", args.threads, "Worker threads (default: all cores)")
       ->check(integer_in(1, 4096));
   render->add_option("--set", args.sets,
@@ -789,8 +810,10 @@ int run_command(int argc, char** argv, const Cluster& cluster) {
   } catch (const CLI::ParseError& e) {
     // Under mpirun every rank parses the same command line: rank 0 alone says what is wrong.
     if (cluster.rank != 0) return e.get_exit_code() == 0 ? 0 : kExitBadInput;
-    const int code = app.exit(e);
-    return code == 0 ? 0 : kExitBadInput;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // One line (issue 29: CLI11 adds a second, "Run with --help for more information.").
+    std::fprintf(stderr, "nimbus: %s\n", nimbus::printable_line(e.what()).c_str());
+    return kExitBadInput;
   }
   try {
     if (cluster.size > 1 && !render->parsed()) {
@@ -803,7 +826,7 @@ int run_command(int argc, char** argv, const Cluster& cluster) {
     if (export_vdb->parsed()) return run_export_vdb(exp_vdb);
     return run_render(args, cluster);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "nimbus: %s\n", e.what());
+    std::fprintf(stderr, "nimbus: %s\n", nimbus::printable_line(e.what()).c_str());
     // The other ranks may be waiting for this one: end them all.
     if (cluster.size > 1) cluster_abort(kExitFailure);
     return kExitFailure;

@@ -207,6 +207,9 @@ TEST(MemoryEstimate, CountsTheFilmAndParsesSizes) {
   EXPECT_EQ(parse_memory_size("1T"), 1ull << 40);
   EXPECT_THROW(parse_memory_size("-1G"), std::invalid_argument);
   EXPECT_THROW(parse_memory_size("lots"), std::invalid_argument);
+  // Issue 29: std::stod alone read "0x10" as 16 bytes; decimal digits only.
+  for (const char* bad : {"0x10", "", "inf", "nan", "1e3", ".5", " 5G"})
+    EXPECT_THROW(parse_memory_size(bad), std::invalid_argument) << '"' << bad << '"';
   EXPECT_EQ(format_memory(3.0 * (1 << 30)), "3.0 GiB");
   EXPECT_EQ(format_memory(512.0 * (1 << 20)), "512.0 MiB");
 }

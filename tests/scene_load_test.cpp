@@ -700,16 +700,79 @@ TEST(SceneLoad, OverridesReplaceAndCreateValues) {
 
 // Issue 16: inline unions nested 5 000 deep and chains of 30 000 named aliases crashed the
 // loader (stack overflow). Beyond kMaxShapeDepth levels they are one error at the place.
+// Issue 29: a shape named "x\ny" split an error over two lines, "\u001b[31m" sent an escape
+// sequence to the terminal, an overlong UTF-8 form was echoed raw, a 10 MB key made a 10 MB
+// line. Every scene error is one printable line of bounded length.
+TEST(SceneLoad, MessagesAreOnePrintableBoundedLine) {
+  EXPECT_EQ(printable_line("a\nb\tc\x1b[31md\x7f"), "a\\nb\\tc\\x1b[31md\\x7f");
+  EXPECT_EQ(printable_line("caf\xc3\xa9 \xe2\x88\x9e \xf0\x9f\x8c\xab"),
+            "caf\xc3\xa9 \xe2\x88\x9e \xf0\x9f\x8c\xab");                 // UTF-8 stays
+  EXPECT_EQ(printable_line("\xc0\x80"), "\\xc0\\x80");                    // overlong NUL
+  EXPECT_EQ(printable_line("\xe0\x80\xaf"), "\\xe0\\x80\\xaf");           // overlong '/'
+  EXPECT_EQ(printable_line("\xed\xa0\x80"), "\\xed\\xa0\\x80");           // a surrogate
+  EXPECT_EQ(printable_line("\xf4\x90\x80\x80"), "\\xf4\\x90\\x80\\x80");  // past U+10FFFF
+  EXPECT_EQ(printable_line("\xc2\x9b"
+                           "1m"),
+            "\\xc2\\x9b"
+            "1m");                                      // C1 CSI
+  EXPECT_EQ(printable_line("\xe2\x88"), "\\xe2\\x88");  // cut short
+  const std::string big(10 << 20, 'k');
+  const std::string cut = printable_line("key " + big + " end");
+  EXPECT_LE(cut.size(), kMaxMessageBytes);
+  EXPECT_NE(cut.find("(10485768 bytes in all)"), std::string::npos) << cut.substr(0, 80);
+  EXPECT_EQ(cut.substr(cut.size() - 4), " end");
+
+  for (const std::string name : {"x\\ny", "\\u001b[31mred", "\\u0085next"}) {
+    const std::string message =
+        load_error(with_camera(R"("shapes": {")" + name + R"(": {"type": "blobb"}})"));
+    EXPECT_EQ(message.find_first_of("\n\x1b"), std::string::npos) << message;
+    EXPECT_EQ(message.find("\xc2\x85"), std::string::npos) << message;
+    EXPECT_NE(message.find("unknown"), std::string::npos) << message;
+  }
+  const std::string message = load_error(with_camera(R"("shapes": {")" + big + R"(": 1})"));
+  EXPECT_LE(message.size(), kMaxMessageBytes);
+}
+
+// Issue 29: numbers past a double had no JSON path ("number overflow parsing '1e400'") or became
+// strings through --set ("not a string"), a seed past 2^64 - 1 was "a fraction", and duplicate
+// keys in a --set value were accepted.
+TEST(SceneLoad, NumbersOutOfRangeAndDuplicateKeysInSetAreNamed) {
+  const std::string range = "beyond a double's range (finite, at most 1.8e308 in magnitude)";
+  const auto text_error = [](const std::string& text) {
+    try {
+      load_scene_text(text, "scene.json");
+    } catch (const SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_EQ(text_error(with_camera(R"("film": {"width": 1e400})")),
+            "scene.json: /film/width: the number 1e400 is " + range);
+  EXPECT_EQ(text_error(with_camera(
+                R"("lights": [{"type": "point", "position": [0, -1e999, 0], "intensity": 1}])")),
+            "scene.json: /lights/0/position/1: the number -1e999 is " + range);
+  EXPECT_EQ(load_error(with_camera(""), {"camera.fov=1e999"}),
+            "--set camera.fov=1e999: a number " + range);
+  EXPECT_EQ(load_error(with_camera(""), {R"(camera={"from": [0, 0, 5], "from": [1, 1, 1]})"}),
+            R"(--set camera={"from": [0, 0, 5], "from": [1, 1, 1]}: /from: duplicate key "from")");
+  EXPECT_EQ(load_error(with_camera(""), {"integrator.seed=18446744073709551616"}),
+            "--set integrator.seed=18446744073709551616: /integrator/seed: must be <= "
+            "18446744073709551615");
+  EXPECT_EQ(load(with_camera(""), {"integrator.seed=18446744073709551615"}).integrator.seed,
+            18446744073709551615ull);
+}
+
 TEST(SceneLoad, DeeplyNestedShapesAreAnErrorNotACrash) {
   std::string text = R"({"type": "sphere", "radius": 1})";
   for (int i = 0; i < 5000; ++i) text = R"({"type": "union", "shapes": [)" + text + "]}";
   const std::string nested = load_error(with_object(R"({"shape": )" + text + "}"));
   std::string at = "/objects/0/shape";
   for (int i = 0; i < kMaxShapeDepth; ++i) at += "/shapes/0";
-  EXPECT_EQ(nested, "scene.json: " + at + ": shapes nest more than " +
-                        std::to_string(kMaxShapeDepth) +
-                        " levels deep here (inline shapes, bases, perturbations, children and "
-                        "named references together)");
+  // Cut to kMaxMessageBytes around the middle of the pointer.
+  EXPECT_EQ(nested, printable_line("scene.json: " + at + ": shapes nest more than " +
+                                   std::to_string(kMaxShapeDepth) +
+                                   " levels deep here (inline shapes, bases, perturbations, "
+                                   "children and named references together)"));
 
   std::string shapes;
   for (int i = 0; i < 30000; ++i)
@@ -785,7 +848,9 @@ TEST_F(SceneFileTest, SyntaxErrorGivesLineAndColumn) {
 
 TEST_F(SceneFileTest, NumberOverflowIsAnError) {
   const std::string path = write(R"({"film": {"width": 1e400}})");
-  EXPECT_EQ(file_error(path), path + ": number overflow parsing '1e400'");
+  EXPECT_EQ(file_error(path), path +
+                                  ": /film/width: the number 1e400 is beyond a double's range "
+                                  "(finite, at most 1.8e308 in magnitude)");
 }
 
 TEST_F(SceneFileTest, MissingFileIsAnError) {

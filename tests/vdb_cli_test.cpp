@@ -138,6 +138,11 @@ TEST_F(VdbCli, ExportVdbRefusesBadInputWithExitTwoAndNoOutput) {
   const Case cases[] = {
       {"export-vdb scene.json -o out.vdb --voxel-size 0", "nimbus: --voxel-size must be > 0"},
       {"export-vdb scene.json -o out.vdb --voxel-size 1e-5", "nimbus: --voxel-size 1e-05: "},
+      // Issue 29: these overflowed the voxel count and ended in OpenVDB's ArithmeticError, exit 1.
+      {"export-vdb scene.json -o out.vdb --voxel-size 1e-300",
+       "nimbus: --voxel-size 1e-300: the object's bounds hold inf voxels"},
+      {"export-vdb scene.json -o out.vdb --voxel-size 5e-324",
+       "nimbus: --voxel-size 5e-324: the object's bounds hold inf voxels"},
       {"export-vdb scene.json -o out.vdb --voxel-size 0.1 --object 7",
        "nimbus: --object 7: scene.json has 2 objects (0 to 1)"},
       {"export-vdb scene.json -o out.vdb --voxel-size 0.1 --object 0",

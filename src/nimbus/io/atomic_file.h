@@ -17,6 +17,9 @@
 
 namespace nimbus {
 
+// The most bytes that the name of a temporary file adds to its target's: ".tmp-PID-N".
+inline constexpr size_t kTempSuffixMaxBytes = 24;
+
 // Creates a fresh temporary file next to `path`, calls `write_to(temp_path)` to fill it, flushes
 // it to disk and renames it to `path` (inside an OutputTransaction: at its commit). On any
 // failure, including an exception from `write_to`, the temporary file is removed and

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "nimbus/io/atomic_file.h"
 #include "nimbus/io/exr.h"
 #include "nimbus/io/png.h"
 
@@ -53,6 +54,15 @@ void check_writable_path(const std::string& path) {
   if (::access(dir.c_str(), W_OK) != 0)
     throw std::runtime_error(path + ": directory " + dir.string() + " is not writable");
   if (fs::is_directory(path, ec)) throw std::runtime_error(path + ": is a directory");
+  // The temporary file's name is longer than the target's (io/atomic_file.h): a name that is
+  // legal but leaves no room for it failed only after the render (issue 29).
+  const long name_max = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+  const size_t most = size_t(name_max > 0 ? name_max : 255) - kTempSuffixMaxBytes;
+  if (const size_t name = fs::path(path).filename().string().size(); name > most)
+    throw std::runtime_error(fmt::format(
+        "{}: the file name has {} bytes; an output's may have at most {} (the folder's {}, less "
+        "room for its temporary file)",
+        path, name, most, name_max > 0 ? name_max : 255));
   // Files there are devices and kernel interfaces, not images: /dev/full.exr was written.
   const std::string real = fs::weakly_canonical(fs::absolute(dir), ec).string();
   for (const char* special : {"/dev", "/proc", "/sys"})

@@ -26,8 +26,14 @@ struct AxisRange {
   long long first, last;
 };
 
+// Saturated at 2^62 in magnitude, so that the cast is defined for any quotient (issue 29: a
+// voxel size of 1e-300 overflowed it); indices past 2^30 are refused below.
+long long to_index(double x) {
+  return static_cast<long long>(std::clamp(x, -0x1p62, 0x1p62));
+}
+
 AxisRange axis_range(double lo, double hi, double h) {
-  return {static_cast<long long>(std::ceil(lo / h)), static_cast<long long>(std::floor(hi / h))};
+  return {to_index(std::ceil(lo / h)), to_index(std::floor(hi / h))};
 }
 
 long long floor_div(long long a, long long b) {
@@ -59,10 +65,11 @@ int vdb_export_object(const SceneDesc& desc, int requested) {
 
 double vdb_export_voxels(const Scene& scene, int object, double h) {
   const Box& b = scene.objects.at(object).bounds;
+  // In doubles: the quotients may be far past any integer type.
   double count = 1;
   for (int k = 0; k < 3; ++k) {
-    const AxisRange r = axis_range(b.lo[k], b.hi[k], h);
-    count *= double(std::max(0LL, r.last - r.first + 1));
+    const double n = std::floor(b.hi[k] / h) - std::ceil(b.lo[k] / h) + 1;
+    count *= std::isnan(n) ? std::numeric_limits<double>::infinity() : std::max(0.0, n);
   }
   return count;
 }
@@ -75,7 +82,7 @@ VdbExportResult export_vdb(const Scene& scene, int object, double h, const std::
   if (obj.medium < 0) throw std::invalid_argument(fmt::format("object {} holds no medium", object));
   const Medium& medium = scene.media[obj.medium];
   const double voxels = vdb_export_voxels(scene, object, h);
-  if (voxels > kVdbExportMaxVoxels)
+  if (!(voxels <= kVdbExportMaxVoxels))
     throw std::invalid_argument(fmt::format(
         "--voxel-size {}: the object's bounds hold {:.3g} voxels, more than the {:.3g} an export "
         "may have; use a larger voxel size",

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <stdexcept>
@@ -37,10 +38,15 @@ std::uint64_t available_memory() {
 }
 
 std::uint64_t parse_memory_size(const std::string& text) {
+  // Decimal digits with an optional fraction (std::stod alone also took "0x10" as 16 bytes, and
+  // "inf" or "1e3").
   size_t used = 0;
+  while (used < text.size() &&
+         (std::isdigit(static_cast<unsigned char>(text[used])) || (text[used] == '.' && used > 0)))
+    ++used;
   double value = 0;
   try {
-    value = std::stod(text, &used);
+    if (used > 0) value = std::stod(text.substr(0, used));
   } catch (const std::exception&) {
     used = 0;
   }

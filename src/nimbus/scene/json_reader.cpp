@@ -87,6 +87,56 @@ void JsonValue::fail(std::string_view problem) const {
   throw SceneError(fmt::format("{}: {}: {}", origin, pointer_.empty() ? "/" : pointer_, problem));
 }
 
+namespace {
+
+// The length of the well-formed UTF-8 sequence at text[i] (1 to 4), or 0 if there is none there
+// (a stray continuation byte, an overlong form, a surrogate, past U+10FFFF, cut short).
+size_t utf8_sequence_at(std::string_view text, size_t i) {
+  const auto byte = [&](size_t k) { return static_cast<unsigned char>(text[k]); };
+  const unsigned char b = byte(i);
+  if (b < 0x80) return 1;
+  const size_t n = (b >> 5) == 0x6 ? 2 : (b >> 4) == 0xe ? 3 : (b >> 3) == 0x1e ? 4 : 0;
+  if (n == 0 || i + n > text.size()) return 0;
+  uint32_t cp = b & (0x7f >> n);
+  for (size_t k = 1; k < n; ++k) {
+    if ((byte(i + k) >> 6) != 0x2) return 0;
+    cp = (cp << 6) | (byte(i + k) & 0x3f);
+  }
+  constexpr uint32_t kLeast[5] = {0, 0, 0x80, 0x800, 0x10000};
+  if (cp < kLeast[n] || cp > 0x10ffff || (cp >= 0xd800 && cp <= 0xdfff)) return 0;
+  return n;
+}
+
+}  // namespace
+
+std::string printable_line(std::string_view text) {
+  std::string out;
+  for (size_t i = 0; i < text.size();) {
+    const auto b = static_cast<unsigned char>(text[i]);
+    const size_t n = utf8_sequence_at(text, i);
+    // U+0080-U+009F (C1 controls) are two bytes, 0xc2 0x80-0x9f.
+    const bool c1 = n == 2 && b == 0xc2 && static_cast<unsigned char>(text[i + 1]) < 0xa0;
+    if (b == '\n') {
+      out += "\\n";
+    } else if (b == '\t') {
+      out += "\\t";
+    } else if (n == 0 || b < 0x20 || b == 0x7f || c1) {
+      for (size_t k = 0; k < std::max<size_t>(n, 1); ++k)
+        out += fmt::format("\\x{:02x}", static_cast<unsigned char>(text[i + k]));
+    } else {
+      out.append(text.substr(i, n));
+    }
+    i += std::max<size_t>(n, 1);
+  }
+  if (out.size() <= kMaxMessageBytes) return out;
+  // Cut on a character boundary: continuation bytes are 10xxxxxx.
+  size_t head = kMaxMessageBytes / 2, tail = out.size() - kMaxMessageBytes / 4;
+  while (head > 0 && (static_cast<unsigned char>(out[head]) >> 6) == 0x2) --head;
+  while (tail < out.size() && (static_cast<unsigned char>(out[tail]) >> 6) == 0x2) ++tail;
+  return fmt::format("{} ... ({} bytes in all) ... {}", out.substr(0, head), text.size(),
+                     out.substr(tail));
+}
+
 void JsonValue::record_input(const std::string& path) const {
   if (origin_->inputs) origin_->inputs->push_back({pointer_, path});
 }
@@ -122,6 +172,13 @@ int JsonValue::integer(const Range& range) const {
 }
 
 uint64_t JsonValue::unsigned_integer() const {
+  // A whole number past 2^64 - 1 is read as a double (issue 29: it was called "a fraction").
+  if (json_->is_number_float()) {
+    const double x = json_->get<double>();
+    if (x == std::floor(x) && std::abs(x) >= 0x1p63)
+      fail(x < 0 ? "must be >= 0"
+                 : fmt::format("must be <= {}", std::numeric_limits<uint64_t>::max()));
+  }
   if (!json_->is_number_integer())
     fail(fmt::format("expected an integer, not {}",
                      json_->is_number() ? "a fraction" : type_name(*json_)));

@@ -19,9 +19,17 @@
 
 namespace nimbus {
 
-// A scene error; the message is the complete one-line report.
+// `text` as one printable line of bounded length, for messages that quote what a file or a flag
+// said: control characters (C0, DEL, C1) and bytes that are not UTF-8 (overlong forms and
+// surrogates included) are written as escapes (\n, \t, \xNN), so that a name cannot split a
+// message or send a terminal an escape sequence; past kMaxMessageBytes the middle is cut and
+// the length said.
+inline constexpr size_t kMaxMessageBytes = 1000;
+std::string printable_line(std::string_view text);
+
+// A scene error; the message is the complete one-line report (printable_line).
 struct SceneError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+  explicit SceneError(std::string_view message) : std::runtime_error(printable_line(message)) {}
 };
 
 // Where a document came from, for messages and relative file names. A value that a --set

@@ -570,6 +570,76 @@ std::string read_file(const std::string& path) {
 
 }  // namespace
 
+// A parser callback that refuses a key given twice in one object (the JSON standard leaves it
+// open; nlohmann's parser keeps one of them silently), naming its JSON path.
+class DuplicateKeys {
+ public:
+  explicit DuplicateKeys(const std::string& source) : source_(source) {}
+  // The pointer of the value the parser reads next (a number it could not hold, say).
+  std::string next_value_pointer() const {
+    if (frames_.empty()) return "/";
+    const Frame& f = frames_.back();
+    return child_pointer(f.pointer, f.array ? std::to_string(f.index + 1) : f.key);
+  }
+  // For nlohmann::json::parse, which copies its callback: this object keeps the state.
+  nlohmann::json::parser_callback_t callback() {
+    return [this](int depth, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+      return (*this)(depth, event, parsed);
+    };
+  }
+  bool operator()(int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+    using E = nlohmann::json::parse_event_t;
+    switch (event) {
+      case E::object_start:
+      case E::array_start:
+        enter_element();
+        frames_.push_back({event == E::array_start,
+                           -1,
+                           {},
+                           frames_.empty() ? "" : child_pointer(here(), key_or_index()),
+                           {}});
+        break;
+      case E::key: {
+        Frame& f = frames_.back();
+        f.key = parsed.get<std::string>();
+        if (!f.keys.insert(f.key).second)
+          throw SceneError(fmt::format("{}: {}: duplicate key \"{}\"", source_,
+                                       child_pointer(f.pointer, f.key), f.key));
+        break;
+      }
+      case E::value:
+        enter_element();
+        break;
+      case E::object_end:
+      case E::array_end:
+        frames_.pop_back();
+        break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool array;
+    long index;  // arrays: the element being read
+    std::set<std::string> keys;
+    std::string pointer;  // of this container
+    std::string key;      // objects: the key being read
+  };
+  void enter_element() {
+    if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
+  }
+  // The parent's pointer and the token under which the container now opening sits.
+  std::string here() const { return frames_.empty() ? "" : frames_.back().pointer; }
+  std::string key_or_index() const {
+    if (frames_.empty()) return "";
+    const Frame& f = frames_.back();
+    return f.array ? std::to_string(f.index) : f.key;
+  }
+  const std::string& source_;
+  std::vector<Frame> frames_;
+};
+
 // "--set KEY=VALUE" as messages show it: a value of any length (up to 240 kB were echoed) is
 // cut after 60 characters.
 std::string set_flag(const std::string& key_equals_value) {
@@ -625,9 +695,15 @@ std::string apply_override(nlohmann::json& j, const std::string& key_equals_valu
     dotted += (dotted.empty() ? "" : ".") + part;
   }
 
+  // Parsed as a file is: a duplicate key is an error (DuplicateKeys throws), and so is a number
+  // beyond a double (issue 29: camera.fov=1e999 became the string "1e999").
   nlohmann::json value;
+  const std::string flag = set_flag(key_equals_value);
+  DuplicateKeys keys(flag);
   try {
-    value = nlohmann::json::parse(text);
+    value = nlohmann::json::parse(text, keys.callback());
+  } catch (const nlohmann::json::out_of_range&) {
+    fail("a number beyond a double's range (finite, at most 1.8e308 in magnitude)");
   } catch (const nlohmann::json::exception&) {
     value = text;  // a bare word such as perspective
   }
@@ -658,70 +734,23 @@ SceneDesc load_scene_json(nlohmann::json j, const std::string& source,
   return load_json_in(std::move(j), source, "", overrides);
 }
 
-// A parser callback that refuses a key given twice in one object (the JSON standard leaves it
-// open; nlohmann's parser keeps one of them silently), naming its JSON path.
-class DuplicateKeys {
- public:
-  explicit DuplicateKeys(const std::string& source) : source_(source) {}
-  bool operator()(int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
-    using E = nlohmann::json::parse_event_t;
-    switch (event) {
-      case E::object_start:
-      case E::array_start:
-        enter_element();
-        frames_.push_back({event == E::array_start,
-                           -1,
-                           {},
-                           frames_.empty() ? "" : child_pointer(here(), key_or_index()),
-                           {}});
-        break;
-      case E::key: {
-        Frame& f = frames_.back();
-        f.key = parsed.get<std::string>();
-        if (!f.keys.insert(f.key).second)
-          throw SceneError(fmt::format("{}: {}: duplicate key \"{}\"", source_,
-                                       child_pointer(f.pointer, f.key), f.key));
-        break;
-      }
-      case E::value:
-        enter_element();
-        break;
-      case E::object_end:
-      case E::array_end:
-        frames_.pop_back();
-        break;
-    }
-    return true;
-  }
-
- private:
-  struct Frame {
-    bool array;
-    long index;  // arrays: the element being read
-    std::set<std::string> keys;
-    std::string pointer;  // of this container
-    std::string key;      // objects: the key being read
-  };
-  void enter_element() {
-    if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
-  }
-  // The parent's pointer and the token under which the container now opening sits.
-  std::string here() const { return frames_.empty() ? "" : frames_.back().pointer; }
-  std::string key_or_index() const {
-    if (frames_.empty()) return "";
-    const Frame& f = frames_.back();
-    return f.array ? std::to_string(f.index) : f.key;
-  }
-  const std::string& source_;
-  std::vector<Frame> frames_;
-};
-
 namespace {
 
 nlohmann::json parse_scene_text(const std::string& text, const std::string& source) {
   nlohmann::json j;
+  DuplicateKeys keys(source);
   try {
-    j = nlohmann::json::parse(text, DuplicateKeys(source), true, /*ignore_comments=*/true);
+    j = nlohmann::json::parse(text, keys.callback(), true, /*ignore_comments=*/true);
+  } catch (const nlohmann::json::out_of_range& e) {
+    // "number overflow parsing '1e400'", without a place (issue 29): the path of the value.
+    const std::string what = e.what();
+    const size_t open = what.find('\''), close = what.rfind('\'');
+    const std::string number =
+        open != std::string::npos && close > open ? what.substr(open + 1, close - open - 1) : "";
+    throw SceneError(
+        fmt::format("{}: {}: the number {} is beyond a double's range (finite, at "
+                    "most 1.8e308 in magnitude)",
+                    source, keys.next_value_pointer(), number));
   } catch (const nlohmann::json::exception& e) {
     // what() is "[json.exception.parse_error.101] parse error at line 3, column 5: ..." (or an
     // out_of_range error for numbers beyond double).
