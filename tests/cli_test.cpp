@@ -34,6 +34,12 @@ class Cli : public ::testing::Test {
     return p.string();
   }
   Ran run(const std::string& args) { return run_nimbus_in(dir_, args); }
+  // `args` is refused with exit 2 and exactly the one line `err`.
+  void expect_refused(const std::string& args, const std::string& err) {
+    const Ran r = run(args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(r.err, err) << args;
+  }
   // Everything left in the directory besides the scene files.
   std::vector<std::string> outputs() const {
     std::vector<std::string> out;
@@ -165,10 +171,8 @@ TEST_F(Cli, UsageErrorsExitTwo) {
   const Ran seed_top = run("render scene.json --seed 18446744073709551615 --spp 1 -o top.png");
   EXPECT_EQ(seed_top.code, 0) << seed_top.err;
   fs::remove(dir_ / "top.png");
-  const Ran seed_over = run("render scene.json --seed 18446744073709551616");
-  EXPECT_EQ(seed_over.code, 2);
-  EXPECT_EQ(seed_over.err,
-            "nimbus: --seed: must be <= 18446744073709551615, not 18446744073709551616\n");
+  expect_refused("render scene.json --seed 18446744073709551616",
+                 "nimbus: --seed: must be <= 18446744073709551615, not 18446744073709551616\n");
   const Ran words = run("render scene.json --seed many");
   EXPECT_EQ(words.code, 2);
   EXPECT_NE(words.err.find("--seed: must be a whole number, not \"many\""), std::string::npos)
@@ -351,14 +355,10 @@ TEST_F(Cli, RendersThatWouldNotFitAreRefusedUpFront) {
   EXPECT_EQ(bad.code, 2);
   EXPECT_EQ(bad.err, "nimbus: --max-memory: \"10x\": unknown size suffix \"x\" (K, M, G or T)\n");
   // Issue 29: an empty size was taken as the default, and 0x10 as 16 bytes.
-  const Ran empty = run("render scene.json --max-memory '' -o a.png");
-  EXPECT_EQ(empty.code, 2);
-  EXPECT_EQ(empty.err,
-            "nimbus: --max-memory: \"\" is not a size (a positive number with K, M, G or T)\n");
-  const Ran hex = run("render scene.json --max-memory 0x10 -o a.png");
-  EXPECT_EQ(hex.code, 2);
-  EXPECT_EQ(hex.err,
-            "nimbus: --max-memory: \"0x10\" is not a size (a positive number with K, M, G or T)\n");
+  for (const std::string size : {"", "0x10"})
+    expect_refused("render scene.json --max-memory '" + size + "' -o a.png",
+                   "nimbus: --max-memory: \"" + size +
+                       "\" is not a size (a positive number with K, M, G or T)\n");
   EXPECT_TRUE(outputs().empty());
   EXPECT_EQ(run("render scene.json --max-memory 1.5G --spp 1 -o a.png").code, 0);
 }
