@@ -1,5 +1,5 @@
 #pragma once
-// A medium's density: the factor on its coefficients sigma_a, sigma_s at a point (DESIGN.md,
+// A medium's density: the factor on its coefficients sigma_a, sigma_s at a point (docs/design.md,
 // "Plug-in types"). A density answers two questions, its value at a point and a conservative
 // range over a box; the lookups (medium_field.h) and the majorant octree (octree.h) ask nothing
 // else, so a constant, an object's own function, a procedural cloud and a voxel grid are equals.

@@ -1,7 +1,8 @@
 #pragma once
-// The medium as a field (DESIGN.md): wherever an index-matched object's function is positive its
-// medium is present, and overlapping media add. Inside a solid object (a dielectric with a
-// medium) only that object's medium is present: a solid displaces the media around it.
+// The medium as a field (docs/design.md, "The medium is a field"): wherever an index-matched
+// object's function is positive its medium is present, and overlapping media add. Inside a solid
+// object (a dielectric with a medium) only that object's medium is present: a solid displaces the
+// media around it.
 // Everything here works on a path's N channels (spectral/channels.h) and on any scene that has
 // what the media layer needs (media_scene.h).
 

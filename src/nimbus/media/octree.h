@@ -1,5 +1,5 @@
 #pragma once
-// The majorant octree (DESIGN.md, "Majorants and minorants are one structure"): an adaptive
+// The majorant octree (docs/design.md, "Majorants and minorants are one structure"): an adaptive
 // octree over the media's bounds holding, per node and per channel (bin), a majorant mu_bar and a
 // minorant mu_c of mu_t. Free-path estimators get their rates from a front-to-back walk of the
 // leaves a ray crosses, so tight bounds where the medium is thin mean few null collisions there.

@@ -13,8 +13,9 @@
 //
 // Without absorption events (paper step 8), P_a = 0 and the source term of the RTE is collected
 // by its collision estimate at every tentative collision instead: with free flights of density
-// mu_bar exp(−mu_bar t), the integral form L = ∫ T̄ (mu_a L_e + mu_s L_s + mu_n L) dt (NOTES.md
-// §2) is estimated by w mu_a L_e / mu_bar + w mu_*/(mu_bar P_*) L_* for the sampled * ∈ {s, n}.
+// mu_bar exp(−mu_bar t), the integral form L = ∫ T̄ (mu_a L_e + mu_s L_s + mu_n L) dt
+// (docs/design.md, "Radiative transfer with null collisions") is estimated by
+// w mu_a L_e / mu_bar + w mu_*/(mu_bar P_*) L_* for the sampled * ∈ {s, n}.
 // With absorption events, the emission is collected once, at an absorption: w mu_a/(mu_bar P_a)
 // L_e.
 
