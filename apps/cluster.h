@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "nimbus/job/job_channel.h"
+
 struct Cluster {
   int rank = 0;
   int size = 1;
@@ -23,10 +25,7 @@ void cluster_end();
 // Ends every rank of the job at once (MPI_Abort), for failures a rank cannot report.
 [[noreturn]] void cluster_abort(int code);
 
-struct ClusterMessage {
-  int from = 0;
-  std::vector<std::byte> bytes;
-};
+using ClusterMessage = nimbus::JobChannel::Message;
 
 void cluster_send(int to, int tag, std::span<const std::byte> bytes);
 // A message with `tag` from any rank, if one has arrived; never waits.
@@ -46,3 +45,20 @@ ClusterFailure cluster_agree(int code, const std::string& message);
 
 // Collective: rank 0's value on every rank.
 uint64_t cluster_broadcast(uint64_t value);
+
+// The cluster as a render job's channel (nimbus/job/job_channel.h). The job's messages use tags
+// 1 and 2; the command line's own, 3 and up.
+class ClusterChannel : public nimbus::JobChannel {
+ public:
+  explicit ClusterChannel(const Cluster& cluster) : cluster_(cluster) {}
+  int rank() const override { return cluster_.rank; }
+  int size() const override { return cluster_.size; }
+  void send(int to, int tag, std::span<const std::byte> bytes) override {
+    cluster_send(to, tag, bytes);
+  }
+  std::optional<Message> poll(int tag) override { return cluster_poll(tag); }
+  Message receive(int from, int tag) override { return cluster_receive(from, tag); }
+
+ private:
+  Cluster cluster_;
+};

@@ -13,6 +13,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -23,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "cluster.h"
 #include "nimbus/experiments/experiment.h"
 #include "nimbus/io/atomic_file.h"
 #include "nimbus/io/film_image.h"
@@ -30,13 +32,13 @@
 #include "nimbus/io/vdb_export.h"
 #include "nimbus/job/checkpoint.h"
 #include "nimbus/job/fingerprint.h"
+#include "nimbus/job/render_job.h"
 #include "nimbus/render/memory_estimate.h"
 #include "nimbus/render/path_spectra.h"
 #include "nimbus/render/renderer.h"
 #include "nimbus/render/stats.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
-#include "render_job.h"
 
 namespace {
 
@@ -109,39 +111,6 @@ struct Outcome {
   std::string message;
 };
 
-// Refuses, with one line and exit 2, a render that the machine (or --max-memory) cannot hold,
-// before anything large is allocated (render/memory_estimate.h).
-Outcome check_memory(const nimbus::SceneDesc& desc, const RenderArgs& args) {
-  using namespace nimbus;
-  int octrees = 1;
-  for (const ObjectDesc& o : desc.objects)
-    octrees += o.medium >= 0 && o.surface.type == SurfaceDesc::Type::Dielectric;
-  const int bins = desc.spectrum.mode == SpectralSettings::Mode::Spectral ? kSpectralBins : 3;
-  const int threads = args.threads > 0 ? args.threads : int(std::thread::hardware_concurrency());
-  const MemoryEstimate need =
-      estimate_render_memory(desc.film.width, desc.film.height, octrees, bins, threads);
-  std::uint64_t limit = 0;
-  std::string source = "available";
-  try {
-    if (args.max_memory) {
-      limit = parse_memory_size(*args.max_memory);
-      source = "allowed by --max-memory";
-    } else {
-      limit = available_memory();
-    }
-  } catch (const std::invalid_argument& e) {
-    return {kExitBadInput, fmt::format("nimbus: --max-memory: {}", e.what())};
-  }
-  if (limit > 0 && need.total() > double(limit))
-    return {kExitBadInput,
-            fmt::format("nimbus: the render needs about {} (film {}, image {}, majorant octrees "
-                        "{}), more than the {} {}",
-                        format_memory(need.total()), format_memory(need.film),
-                        format_memory(need.image), format_memory(need.octrees),
-                        format_memory(double(limit)), source)};
-  return {};
-}
-
 // The files a run reads: the scene file and every file its description made the loader read.
 std::vector<nimbus::NamedFile> scene_inputs(const std::string& scene,
                                             const nimbus::SceneDesc& desc) {
@@ -149,25 +118,6 @@ std::vector<nimbus::NamedFile> scene_inputs(const std::string& scene,
   for (const nimbus::InputFile& f : desc.inputs)
     inputs.push_back({"the file of " + f.pointer, f.path});
   return inputs;
-}
-
-// Refuses a render whose outputs would overwrite what it reads or each other (issue 29: --stats
-// s.json replaced the scene). --resume's file is read, and is written again by the later
-// checkpoints unless --checkpoint names another file.
-void check_render_files(const RenderArgs& args, const std::vector<std::string>& outputs,
-                        const nimbus::SceneDesc& desc) {
-  using nimbus::NamedFile;
-  std::vector<NamedFile> written, read = scene_inputs(args.scene, desc);
-  for (const std::string& out : outputs) written.push_back({"-o", out});
-  if (!args.stats.empty()) written.push_back({"--stats", args.stats});
-  if (!args.checkpoint.empty()) {
-    written.push_back({"--checkpoint", args.checkpoint});
-    if (!args.resume.empty() && !nimbus::same_file(args.resume, args.checkpoint))
-      read.push_back({"the checkpoint of --resume", args.resume});
-  } else if (!args.resume.empty()) {
-    written.push_back({"--resume (its later checkpoints)", args.resume});
-  }
-  nimbus::check_outputs_distinct(written, read);
 }
 
 // Under mpirun every rank runs each step and all agree on its outcome (cluster_agree): a
@@ -183,139 +133,63 @@ int agree(const Cluster& cluster, const Outcome& mine) {
   return f.code;
 }
 
-// The render's inputs once every rank has agreed that they are good.
-struct Prepared {
-  std::vector<std::string> outputs;
-  std::vector<std::string> overrides;
-  std::string checkpoint;      // where checkpoints go; empty: none
-  nimbus::Checkpoint resumed;  // --resume's checkpoint (rank 0)
-  nimbus::SceneDesc desc;
-};
-
-// Rank 0 alone checks the outputs and reads the checkpoint to resume (the other ranks write
-// and read nothing); every rank loads the scene.
-Outcome prepare(const RenderArgs& args, const Cluster& cluster, Prepared& p) {
-  using namespace nimbus;
-  const bool lead = cluster.rank == 0;
-  p.overrides = args.sets;
-  p.checkpoint = !args.checkpoint.empty() ? args.checkpoint : args.resume;
-  if (args.checkpoint_interval > 0 && p.checkpoint.empty())
-    return {kExitBadInput, "nimbus: --checkpoint-interval needs --checkpoint or --resume"};
-  int spp = args.spp;
-  Outcome resume_failed;
-  if (lead && !args.resume.empty()) {
-    try {
-      p.resumed = load_checkpoint(args.resume);
-      // Without --spp a resumed render finishes what the checkpoint's render was asked for.
-      if (spp == 0) spp = p.resumed.spp;
-    } catch (const std::exception& e) {
-      resume_failed = {kExitBadInput, fmt::format("nimbus: --resume: {}", e.what())};
-    }
-  }
-  // Every rank renders with rank 0's spp: a pixel's samples depend on it (integrator.sampler
-  // "zsobol"), and only rank 0 reads the checkpoint.
-  if (!args.resume.empty()) spp = int(cluster_broadcast(uint64_t(spp)));
-  if (resume_failed.code != 0) return resume_failed;
-  if (spp > 0) p.overrides.push_back(fmt::format("integrator.spp={}", spp));
-  if (args.seed) p.overrides.push_back(fmt::format("integrator.seed={}", *args.seed));
-
-  p.outputs = args.outputs;
-  if (p.outputs.empty()) {
-    const std::string stem = std::filesystem::path(args.scene).stem().string();
-    p.outputs = {stem + ".exr", stem + ".png"};
-  }
-  if (lead) try {
-      for (const std::string& out : p.outputs) check_output_path(out);
-      if (!args.stats.empty()) check_writable_path(args.stats);
-      if (!p.checkpoint.empty()) check_writable_path(p.checkpoint);
-    } catch (const std::exception& e) {
-      return {kExitBadInput, fmt::format("nimbus: {}", e.what())};
-    }
+// A step of the render job as an outcome: its refusals are bad input (exit 2), one line.
+template <class Step>
+Outcome attempt(Step&& step) {
   try {
-    p.desc = load_scene_file(args.scene, p.overrides);
-  } catch (const SceneError& e) {
+    step();
+  } catch (const nimbus::SceneError& e) {
     return {kExitBadInput, e.what()};
+  } catch (const nimbus::JobError& e) {
+    return {kExitBadInput, fmt::format("nimbus: {}", e.what())};
   }
-  if (lead) try {
-      check_render_files(args, p.outputs, p.desc);
-    } catch (const std::exception& e) {
-      return {kExitBadInput, fmt::format("nimbus: {}", e.what())};
-    }
-  if (lead && !args.resume.empty()) {
-    const std::string diff = fingerprint_difference(
-        p.resumed.fingerprint, render_fingerprint(args.scene, p.overrides, p.desc.inputs));
-    if (!diff.empty())
-      return {kExitBadInput,
-              fmt::format("nimbus: --resume {}: the checkpoint is of another scene or other "
-                          "settings ({})",
-                          args.resume, diff)};
-    if (p.resumed.film.width != p.desc.film.width || p.resumed.film.height != p.desc.film.height)
-      return {kExitBadInput, fmt::format("nimbus: --resume {}: a film of {}x{} pixels, the "
-                                         "scene's image is {}x{}",
-                                         args.resume, p.resumed.film.width, p.resumed.film.height,
-                                         p.desc.film.width, p.desc.film.height)};
-    const uint32_t most =
-        *std::max_element(p.resumed.film.samples.begin(), p.resumed.film.samples.end());
-    if (most > uint32_t(p.desc.integrator.spp))
-      return {kExitBadInput, fmt::format("nimbus: --resume {}: pixels of the checkpoint hold {} "
-                                         "samples, more than --spp {}",
-                                         args.resume, most, p.desc.integrator.spp)};
-  }
-  return check_memory(p.desc, args);
-}
-
-// Every rank compiles the scene and builds its own majorant octrees; they must be the same bits
-// on every rank (and, on resume, those of the checkpoint's render).
-Outcome compile(const Prepared& p, bool show_progress, nimbus::Scene& scene) {
-  using namespace nimbus;
-  // The majorant octrees can take seconds to build (deep trees, sampled bounds): they get a
-  // bar of their own, and a signal stops them too.
-  BuildMonitor monitor;
-  monitor.cancel = [] { return g_signal.load() != 0; };
-  if (show_progress) monitor.progress = progress_bar("octrees");
-  try {
-    scene = compile_scene(p.desc, monitor);
-  } catch (const SceneError& e) {
-    if (show_progress) std::fprintf(stderr, "\n");
-    return {kExitBadInput, e.what()};
-  }
-  if (show_progress) std::fprintf(stderr, "\n");
-  if (const int sig = g_signal.load(); sig != 0)
-    return {128 + sig,
-            fmt::format("nimbus: stopped by {} while building the majorant octrees; nothing "
-                        "written",
-                        signal_name(sig))};
   return {};
 }
 
-// The checks of the octrees after compile: equal on every rank (a collective call).
-Outcome check_majorants(const Cluster& cluster, const Prepared& p, const RenderArgs& args,
-                        uint64_t mine) {
-  const uint64_t lead = cluster_broadcast(mine);
-  if (mine != lead)
-    return {1, fmt::format("built majorant octrees that differ from rank 0's (hash {:016x}, "
-                           "rank 0 {:016x}): are all ranks running the same nimbus?",
-                           mine, lead)};
-  if (cluster.rank == 0 && !args.resume.empty() && p.resumed.majorants != mine)
-    return {kExitBadInput, fmt::format("nimbus: --resume {}: the checkpoint's majorant octrees "
-                                       "differ from this render's (another nimbus build?)",
-                                       args.resume)};
+// The job's options from the command line's (the parts that are the job's).
+nimbus::RenderJobOptions job_options(const RenderArgs& args) {
+  nimbus::RenderJobOptions o;
+  o.overrides = args.sets;
+  o.spp = args.spp;
+  o.seed = args.seed;
+  o.threads = args.threads;
+  o.checkpoint = args.checkpoint;
+  if (args.checkpoint_interval > 0) o.checkpoint_interval = args.checkpoint_interval;
+  o.resume = args.resume;
+  o.cancel = [] { return g_signal.load() != 0; };
+  o.warning = [](const std::string& w) {
+    std::fprintf(stderr, "\nnimbus: warning: %s\n", nimbus::printable_line(w).c_str());
+  };
+  return o;
+}
+
+// The outputs, and the checks of the command line's own options; refuses a render whose outputs
+// would overwrite what it reads or each other (issue 29: --stats s.json replaced the scene).
+Outcome check_outputs(const RenderArgs& args, const nimbus::RenderJob& job,
+                      const std::vector<std::string>& outputs) {
+  using namespace nimbus;
+  try {
+    std::vector<NamedFile> written;
+    for (const std::string& out : outputs) written.push_back({"-o", out});
+    if (!args.stats.empty()) written.push_back({"--stats", args.stats});
+    for (const NamedFile& f : job.files_written()) written.push_back(f);
+    check_outputs_distinct(written, job.files_read());
+  } catch (const std::exception& e) {
+    return {kExitBadInput, fmt::format("nimbus: {}", e.what())};
+  }
   return {};
 }
 
 // Writes every output as one transaction (io/atomic_file.h): all of them, or none.
 int write_outputs(const RenderArgs& args, const std::vector<std::string>& outputs,
-                  const nimbus::Scene& scene, const nimbus::RenderResult& result,
-                  const nlohmann::json& extra_stats) {
+                  const nimbus::Film& film, const nlohmann::json& stats) {
   using namespace nimbus;
   g_writing = true;
   try {
     OutputTransaction outputs_of_this_run;
-    const Image image = to_image(result.film);
+    const Image image = to_image(film);
     for (const std::string& out : outputs) write_image(out, image);
     if (!args.stats.empty()) {
-      nlohmann::json stats = render_stats(scene, result, args.scene);
-      if (extra_stats.is_object()) stats.update(extra_stats);
       const std::string text = stats.dump(2) + "\n";
       write_atomically(args.stats, [&](const std::string& tmp) {
         std::ofstream f(tmp);
@@ -333,170 +207,162 @@ int write_outputs(const RenderArgs& args, const std::vector<std::string>& output
   return 0;
 }
 
-void warn_rejected(const nimbus::Counters& counters) {
-  if (const uint64_t n = counters.rejected_samples; n > 0)
-    std::fprintf(stderr,
-                 "nimbus: warning: %llu samples were NaN or infinite and counted as 0 "
-                 "(counters.rejected_samples in --stats)\n",
-                 static_cast<unsigned long long>(n));
-}
-
 std::string joined(const std::vector<std::string>& list) {
   std::string s;
   for (const auto& o : list) s += (s.empty() ? "" : ", ") + o;
   return s;
 }
 
-// The render in one call, in this process: no checkpoints, no other ranks.
-int render_at_once(const RenderArgs& args, const Prepared& p, const nimbus::Scene& scene,
-                   bool show_progress) {
+// Rank 0's end of the render: what was rendered is written, or why not is said.
+int finish_render(const RenderArgs& args, const nimbus::RenderJob& job,
+                  const std::vector<std::string>& outputs, const nimbus::JobOutcome& r) {
   using namespace nimbus;
-  RenderOptions options;
-  options.threads = args.threads;
-  options.cancel = [] { return g_signal.load() != 0; };
-  if (show_progress) options.progress = progress_bar("render");
-  const RenderResult result = render(scene, options);
-  if (show_progress) std::fprintf(stderr, "\n");
-  if (const int sig = g_signal.load(); sig != 0) {
-    std::fprintf(stderr, "nimbus: stopped by %s before the render finished; nothing written\n",
-                 signal_name(sig));
-    return 128 + sig;
-  }
-  warn_rejected(result.counters);
-  if (const int failed = write_outputs(args, p.outputs, scene, result, {}); failed != 0)
-    return failed;
-  if (!args.quiet) {
-    const double samples =
-        double(scene.settings.width) * scene.settings.height * scene.settings.spp;
-    std::fprintf(stderr, "nimbus: %dx%d, %d spp in %.2f s (%.3g samples/s, %d threads) -> %s\n",
-                 scene.settings.width, scene.settings.height, scene.settings.spp, result.seconds,
-                 samples / result.seconds, result.threads, joined(p.outputs).c_str());
-  }
-  return 0;
-}
-
-// Rank 0 of a render job (apps/render_job.h): under mpirun, or with --checkpoint or --resume.
-int lead_render_job(const RenderArgs& args, const Cluster& cluster, const Prepared& p,
-                    const nimbus::Scene& scene, bool show_progress) {
-  using namespace nimbus;
-  JobSettings job;
-  job.spp = scene.settings.spp;
-  job.threads = args.threads;
-  job.start =
-      args.resume.empty() ? Film(scene.settings.width, scene.settings.height) : p.resumed.film;
-  const uint64_t held_at_start = samples_held(job.start);
-  // Why the last checkpoint could not be saved; empty: it was, or none was due. Reported in the
-  // run's last line, never as written.
-  auto checkpoint_failure = std::make_shared<std::string>();
-  if (!p.checkpoint.empty()) {
-    Checkpoint header;
-    header.fingerprint = render_fingerprint(args.scene, p.overrides, p.desc.inputs);
-    header.majorants = majorant_hash(scene);
-    header.spp = scene.settings.spp;
-    job.checkpoint_interval = args.checkpoint_interval > 0 ? args.checkpoint_interval : 60;
-    // Units are short next to the interval, so checkpoints come on time.
-    job.unit_seconds = std::min(job.unit_seconds, job.checkpoint_interval / 4);
-    job.checkpoint = [header, path = p.checkpoint, held_at_start,
-                      checkpoint_failure](const Film& film) mutable {
-      // Nothing rendered yet: the file would gain nothing, and a fresh render's checkpoint
-      // would replace an earlier one with an empty film.
-      if (samples_held(film) == held_at_start) return;
-      header.film = film;
-      try {
-        save_checkpoint(header, path);
-        checkpoint_failure->clear();
-      } catch (const std::exception& e) {
-        *checkpoint_failure = e.what();
-        std::fprintf(stderr, "\nnimbus: warning: --checkpoint: %s (not saved)\n", e.what());
-      }
-    };
-  }
-  if (show_progress) job.progress = progress_bar("render");
-  job.stop = [] { return g_signal.load() != 0; };
-  const JobResult r = lead_job(scene, cluster, std::move(job));
-  if (show_progress) std::fprintf(stderr, "\n");
   const int sig = g_signal.load();
-  // Stopped without a checkpoint: as a render in one call, nothing is written. With one, the
-  // film holds whole units only, and its image so far is written too.
-  if (r.stopped && p.checkpoint.empty()) {
+  const std::string& checkpoint = job.checkpoint_file();
+  // Stopped without a checkpoint: nothing is written. With one, the film holds whole units
+  // only, and its image so far is written too, unless no unit was done: the image would be the
+  // one at the start (empty for a fresh render) and replace an earlier good one.
+  if (r.stopped && checkpoint.empty()) {
     std::fprintf(stderr, "nimbus: stopped by %s before the render finished; nothing written\n",
                  signal_name(sig));
     return 128 + sig;
   }
-  // Stopped before a unit was done: the image so far would be the one at the start (empty for a
-  // fresh render) and replace an earlier good one.
-  if (r.stopped && samples_held(r.film) == held_at_start) {
+  const uint64_t held = samples_held(r.film);
+  if (r.stopped && held == r.samples_at_start) {
     std::fprintf(stderr, "nimbus: stopped by %s before a sample was rendered; nothing written\n",
                  signal_name(sig));
     return 128 + sig;
   }
-  warn_rejected(r.counters);
-  RenderResult result;
-  result.film = std::move(r.film);
-  result.counters = r.counters;
-  result.seconds = r.seconds;
-  result.threads = args.threads > 0 ? args.threads : int(std::thread::hardware_concurrency());
-  nlohmann::json extra;
-  if (cluster.mpi)
-    extra["mpi"] = {{"ranks", cluster.size}, {"samples_per_rank", r.samples_per_rank}};
-  const uint64_t held = samples_held(result.film);
-  if (!p.checkpoint.empty())
-    extra["checkpoint"] = {
-        {"file", p.checkpoint}, {"samples_at_start", held_at_start}, {"samples", held}};
-  if (const int failed = write_outputs(args, p.outputs, scene, result, extra); failed != 0)
+  if (const uint64_t n = r.counters.rejected_samples; n > 0)
+    std::fprintf(stderr,
+                 "nimbus: warning: %llu samples were NaN or infinite and counted as 0 "
+                 "(counters.rejected_samples in --stats)\n",
+                 static_cast<unsigned long long>(n));
+  if (const int failed = write_outputs(args, outputs, r.film, job.stats(r)); failed != 0)
     return failed;
-  const double total = double(scene.settings.width) * scene.settings.height * scene.settings.spp;
+  const RenderSettings& s = job.scene().settings;
   if (r.stopped) {
-    if (checkpoint_failure->empty())
+    const double done = 100 * double(held) / (double(s.width) * s.height * s.spp);
+    if (r.checkpoint_failure.empty())
       std::fprintf(stderr,
                    "nimbus: stopped by %s at %.1f%% of the samples; wrote the image so far to %s "
                    "and the checkpoint %s (continue with --resume %s)\n",
-                   signal_name(sig), 100 * double(held) / total, joined(p.outputs).c_str(),
-                   p.checkpoint.c_str(), p.checkpoint.c_str());
+                   signal_name(sig), done, joined(outputs).c_str(), checkpoint.c_str(),
+                   checkpoint.c_str());
     else
       std::fprintf(stderr,
                    "nimbus: stopped by %s at %.1f%% of the samples; wrote the image so far to %s; "
                    "the checkpoint was not saved (%s)\n",
-                   signal_name(sig), 100 * double(held) / total, joined(p.outputs).c_str(),
-                   checkpoint_failure->c_str());
+                   signal_name(sig), done, joined(outputs).c_str(), r.checkpoint_failure.c_str());
     return 128 + sig;
   }
-  if (!checkpoint_failure->empty()) {
+  if (!r.checkpoint_failure.empty()) {
     std::fprintf(stderr,
                  "nimbus: wrote %s; the last checkpoint was not saved (%s): the render cannot be "
                  "continued from it\n",
-                 joined(p.outputs).c_str(), checkpoint_failure->c_str());
+                 joined(outputs).c_str(), r.checkpoint_failure.c_str());
     return kExitFailure;
   }
-  if (!args.quiet) {
-    const double samples = double(held - held_at_start);
-    std::fprintf(stderr,
-                 "nimbus: %dx%d, %d spp in %.2f s (%.3g samples/s, %d threads x %d %s) -> %s\n",
-                 scene.settings.width, scene.settings.height, scene.settings.spp, r.seconds,
-                 samples / r.seconds, result.threads, cluster.size,
-                 cluster.size == 1 ? "process" : "ranks", joined(p.outputs).c_str());
-  }
+  if (!args.quiet)
+    std::fprintf(stderr, "nimbus: %s -> %s\n", job.summary(r).c_str(), joined(outputs).c_str());
   return 0;
 }
 
+// After the job, rank 0 tells every other rank its exit code; they wait for it.
+constexpr int kExitTag = 3;
+
+void send_exit_code(const Cluster& cluster, int code) {
+  const int32_t c = code;
+  for (int r = 1; r < cluster.size; ++r) cluster_send(r, kExitTag, std::as_bytes(std::span(&c, 1)));
+}
+
+int receive_exit_code() {
+  const ClusterMessage m = cluster_receive(0, kExitTag);
+  int32_t c = kExitFailure;
+  if (m.bytes.size() == sizeof c) std::memcpy(&c, m.bytes.data(), sizeof c);
+  return c;
+}
+
+// `nimbus render`: the library's render job (nimbus/job/render_job.h), its steps agreed on by
+// every rank under mpirun. Rank 0 alone reads the checkpoint to resume and checks the outputs
+// (the other ranks write and read nothing); every rank loads and compiles the scene and builds
+// its own majorant octrees, which must be the same bits on every rank.
 int run_render(const RenderArgs& args, const Cluster& cluster) {
   using namespace nimbus;
   const bool lead = cluster.rank == 0;
-  Prepared p;
-  if (const int code = agree(cluster, prepare(args, cluster, p)); code != 0) return code;
+  if (args.checkpoint_interval > 0 && args.checkpoint.empty() && args.resume.empty())
+    return agree(cluster,
+                 {kExitBadInput, "nimbus: --checkpoint-interval needs --checkpoint or --resume"});
+  RenderJobOptions options = job_options(args);
+  if (args.max_memory) {
+    try {
+      options.max_memory = parse_memory_size(*args.max_memory);
+    } catch (const std::invalid_argument& e) {
+      return agree(cluster, {kExitBadInput, fmt::format("nimbus: --max-memory: {}", e.what())});
+    }
+  }
   const bool show_progress = lead && !args.quiet && isatty(fileno(stderr));
-  Scene scene;
-  if (const int code = agree(cluster, compile(p, show_progress, scene)); code != 0) return code;
-  if (const int code = agree(cluster, check_majorants(cluster, p, args, majorant_hash(scene)));
-      code != 0)
-    return code;
+  if (show_progress) options.progress = progress_bar("render");
+  RenderJob job(options);
 
-  if (!cluster.mpi && p.checkpoint.empty()) return render_at_once(args, p, scene, show_progress);
+  int spp = args.spp;
+  Outcome step;
+  if (lead) step = attempt([&] { spp = job.read_resume(); });
+  // Every rank renders with rank 0's spp: a pixel's samples depend on it (integrator.sampler
+  // "zsobol"), and only rank 0 reads the checkpoint.
+  if (!args.resume.empty()) spp = int(cluster_broadcast(uint64_t(spp)));
+  if (const int code = agree(cluster, step); code != 0) return code;
+
+  std::vector<std::string> outputs = args.outputs;
+  if (outputs.empty()) {
+    const std::string stem = std::filesystem::path(args.scene).stem().string();
+    outputs = {stem + ".exr", stem + ".png"};
+  }
+  if (lead) try {
+      for (const std::string& out : outputs) check_output_path(out);
+      if (!args.stats.empty()) check_writable_path(args.stats);
+      if (!job.checkpoint_file().empty()) check_writable_path(job.checkpoint_file());
+    } catch (const std::exception& e) {
+      step = {kExitBadInput, fmt::format("nimbus: {}", e.what())};
+    }
+  if (step.code == 0) step = attempt([&] { job.load(args.scene, spp); });
+  if (lead && step.code == 0) step = check_outputs(args, job, outputs);
+  if (lead && step.code == 0) step = attempt([&] { job.check(); });
+  if (const int code = agree(cluster, step); code != 0) return code;
+
+  // The majorant octrees can take seconds to build (deep trees, sampled bounds): they get a
+  // bar of their own, and a signal stops them too.
+  BuildMonitor monitor;
+  monitor.cancel = options.cancel;
+  if (show_progress) monitor.progress = progress_bar("octrees");
+  bool compiled = false;
+  step = attempt([&] { compiled = job.compile(monitor); });
+  if (show_progress) std::fprintf(stderr, "\n");
+  if (step.code == 0 && !compiled) {
+    const int sig = g_signal.load();
+    step = {128 + sig, fmt::format("nimbus: stopped by {} while building the majorant octrees; "
+                                   "nothing written",
+                                   signal_name(sig))};
+  }
+  if (const int code = agree(cluster, step); code != 0) return code;
+  const uint64_t mine = majorant_hash(job.scene()), first = cluster_broadcast(mine);
+  if (mine != first)
+    step = {kExitFailure, fmt::format("built majorant octrees that differ from rank 0's (hash "
+                                      "{:016x}, rank 0 {:016x}): are all ranks running the same "
+                                      "nimbus?",
+                                      mine, first)};
+  else if (lead)
+    step = attempt([&] { job.check_majorants(); });
+  if (const int code = agree(cluster, step); code != 0) return code;
+
+  ClusterChannel channel(cluster);
   if (!lead) {
-    work_on_job(scene, args.threads, [] { return g_signal.load() != 0; });
+    job.work(channel);
     return receive_exit_code();
   }
-  const int code = lead_render_job(args, cluster, p, scene, show_progress);
+  const JobOutcome r = job.run(cluster.mpi ? &channel : nullptr);
+  if (show_progress) std::fprintf(stderr, "\n");
+  const int code = finish_render(args, job, outputs, r);
   send_exit_code(cluster, code);
   return code;
 }

@@ -70,6 +70,33 @@ class Checkpoints : public ::testing::Test {
   fs::path dir_;
 };
 
+// Issue 25: a grid read by the scene, named under a nested key (/media/m/density/file), replaced
+// between the checkpoint and the resume: refused with one line naming the file.
+TEST(CheckpointInputs, AGridChangedSinceTheCheckpointIsRefused) {
+  const fs::path dir = fresh_test_dir("nimbus_ckgrid");
+  const fs::path vdb = fs::path(NIMBUS_SOURCE_DIR) / "scenes/vdb";
+  fs::copy_file(vdb / "vdb_cloud.vdb", dir / "grid.vdb");
+  std::ofstream(dir / "scene.json") << R"({"film": {"width": 8, "height": 6},
+    "camera": {"type": "perspective", "from": [0, 0, 5], "to": [0, 0, 0], "fov": 30},
+    "integrator": {"spp": 2},
+    "lights": [{"type": "environment", "radiance": 1}],
+    "media": {"m": {"sigma_s": 2, "density": {"type": "vdb", "file": "grid.vdb"}}},
+    "objects": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "medium": "m"}]})";
+  ASSERT_EQ(run_nimbus_in(dir, "render scene.json -q --checkpoint ck.nck -o a.exr").code, 0);
+  // The same bytes again: resumed.
+  const Ran same = run_nimbus_in(dir, "render scene.json -q --resume ck.nck --spp 3 -o b.exr");
+  EXPECT_EQ(same.code, 0) << same.err;
+  fs::copy_file(vdb / "vdb_fire.vdb", dir / "grid.vdb", fs::copy_options::overwrite_existing);
+  const Ran changed = run_nimbus_in(dir, "render scene.json -q --resume ck.nck --spp 4 -o c.exr");
+  EXPECT_EQ(changed.code, 2);
+  EXPECT_EQ(changed.err,
+            "nimbus: --resume ck.nck: the checkpoint is of another scene or other settings "
+            "(grid.vdb, named at /media/m/density/file, is not the file the checkpoint's render "
+            "read (its size or content differs))\n");
+  EXPECT_FALSE(fs::exists(dir / "c.exr"));
+  fs::remove_all(dir);
+}
+
 // The exact sums and the counts of two checkpoints' films: the pixels, to the bit.
 void expect_same_pixels(const fs::path& a, const fs::path& b) {
   const Checkpoint x = load_checkpoint(a.string()), y = load_checkpoint(b.string());

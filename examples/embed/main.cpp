@@ -1,11 +1,13 @@
 // Builds a small scene in code (a chromatic cloud in a sphere under a sun and a sky), renders it
-// in two halves of its samples into one film, and writes the image to the path given as the
-// one argument (.png or .exr).
+// in two halves of its samples into one film, then again as a render job that saves a checkpoint
+// at 4 samples per pixel and a second job that continues it to 8 (the same bits), and writes the
+// image to the path given as the one argument (.png or .exr).
 
 #include <nimbus/nimbus.h>
 
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 
 int main(int argc, char** argv) {
   using namespace nimbus;
@@ -52,10 +54,30 @@ int main(int argc, char** argv) {
     render_into(scene, film, options);
     options.range = {0, 0, -1, -1, 4, 8};
     const RenderStats stats = render_into(scene, film, options);
-    write_image(argv[1], to_image(film));
+
+    // The render job: checkpoints, resuming, progress and cancellation. A scene built in code
+    // names what identifies it, which a checkpoint must match to be continued.
+    const nlohmann::json identity = {{"example", "embed"}, {"version", 1}};
+    const std::string checkpoint = std::string(argv[1]) + ".nck";
+    RenderJobOptions first;
+    first.spp = 4;
+    first.checkpoint = checkpoint;
+    RenderJob start(first);
+    start.set_scene(scene, identity);
+    start.run();
+    RenderJobOptions second;
+    second.spp = 8;
+    second.resume = checkpoint;
+    RenderJob resume(second);
+    resume.set_scene(scene, identity);
+    const JobOutcome resumed = resume.run();
+    std::filesystem::remove(checkpoint);
+    if (!(resumed.film.sum == film.sum)) throw std::runtime_error("the resumed render differs");
+    write_image(argv[1], to_image(resumed.film));
     const MeanEstimate m = image_mean(film);
-    std::printf("embed: %s, image mean %.4f %.4f %.4f, %.3f s on %d threads\n", argv[1], m.mean[0],
-                m.mean[1], m.mean[2], stats.seconds, stats.threads);
+    std::printf("embed: %s, image mean %.4f %.4f %.4f, %.3f s on %d threads; resumed: %s\n",
+                argv[1], m.mean[0], m.mean[1], m.mean[2], stats.seconds, stats.threads,
+                resume.summary(resumed).c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "embed: %s\n", e.what());
     return 1;

@@ -8,6 +8,9 @@
 //   Scene scene = compile_scene(desc);                      // or build a Scene in code
 //   RenderResult r = render(scene, options);                // or render_into(scene, film, options)
 //   write_image("out.png", to_image(r.film));
+//
+// A render with checkpoints, resuming, progress and cancellation, as `nimbus render` runs it:
+// RenderJob (job/render_job.h).
 
 #include "nimbus/frep/bounds.h"
 #include "nimbus/frep/primitives.h"
@@ -16,6 +19,7 @@
 #include "nimbus/io/film_image.h"
 #include "nimbus/io/output.h"
 #include "nimbus/io/vdb_export.h"
+#include "nimbus/job/render_job.h"
 #include "nimbus/media/cloud_density.h"
 #include "nimbus/media/constant_density.h"
 #include "nimbus/media/field_density.h"

@@ -2,34 +2,14 @@
 
 #include <fmt/format.h>
 
-#include <filesystem>
-#include <fstream>
-
-#include "nimbus/scene/json_reader.h"
-#include "nimbus/scene/load.h"
+#include "nimbus/math/fnv.h"
 
 namespace nimbus {
-
-uint64_t hash_bytes(std::span<const std::byte> bytes, uint64_t h) {
-  for (std::byte b : bytes) h = (h ^ uint64_t(b)) * 0x100000001b3ull;
-  return h;
-}
-
 namespace {
 
 template <class T>
 uint64_t hash_value(const T& v, uint64_t h) {
   return hash_bytes(std::as_bytes(std::span(&v, 1)), h);
-}
-
-uint64_t hash_file(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneError(path.string() + ": cannot open file");
-  uint64_t h = 0xcbf29ce484222325ull;
-  std::vector<char> buffer(1 << 16);
-  while (in.read(buffer.data(), std::streamsize(buffer.size())) || in.gcount() > 0)
-    h = hash_bytes(std::as_bytes(std::span(buffer.data(), size_t(in.gcount()))), h);
-  return h;
 }
 
 uint64_t hash_octree(const MajorantOctree& t, uint64_t h) {
@@ -69,29 +49,65 @@ std::string difference(const nlohmann::json& a, const nlohmann::json& b, const s
   return fmt::format("{}: {} in the checkpoint, {} now", key, short_dump(a), short_dump(b));
 }
 
+// The files of two fingerprints ({pointer: {"file", "bytes", "hash"}}), compared by pointer.
+std::string file_difference(const nlohmann::json& saved, const nlohmann::json& now) {
+  const auto path = [](const nlohmann::json& f) {
+    return f.is_object() && f.contains("file") && f["file"].is_string()
+               ? f["file"].get<std::string>()
+               : std::string("?");
+  };
+  for (const auto& [pointer, f] : now.items()) {
+    if (!saved.contains(pointer))
+      return fmt::format("{}, named at {}, was not read by the checkpoint's render", path(f),
+                         pointer);
+    if (saved[pointer] != f)
+      return fmt::format(
+          "{}, named at {}, is not the file the checkpoint's render read (its "
+          "size or content differs)",
+          path(f), pointer);
+  }
+  for (const auto& [pointer, f] : saved.items())
+    if (!now.contains(pointer))
+      return fmt::format("the checkpoint's render read {}, named at {}; this one does not", path(f),
+                         pointer);
+  return {};
+}
+
 }  // namespace
 
-nlohmann::json render_fingerprint(const std::string& scene_path,
-                                  const std::vector<std::string>& overrides,
-                                  const std::vector<InputFile>& inputs) {
-  std::ifstream in(scene_path, std::ios::binary);
-  const std::string text((std::istreambuf_iterator<char>(in)), {});
-  nlohmann::json scene = nlohmann::json::parse(text, nullptr, true, true);
-  for (const std::string& o : overrides) apply_override(scene, o);
-  if (scene.contains("integrator") && scene["integrator"].is_object())
+nlohmann::json render_fingerprint(const SceneDesc& desc) {
+  nlohmann::json scene = desc.document;
+  if (scene.is_object() && scene.contains("integrator") && scene["integrator"].is_object())
     scene["integrator"].erase("spp");
-  // Each file under the JSON pointer that named it, as the loader recorded it.
+  // Each file under the JSON pointer that named it, as the loader recorded it when it read it.
   nlohmann::json files = nlohmann::json::object();
-  for (const InputFile& f : inputs) files[f.pointer] = fmt::format("{:016x}", hash_file(f.path));
+  for (const InputFile& f : desc.inputs)
+    files[f.pointer] = {
+        {"file", f.path}, {"bytes", f.bytes}, {"hash", fmt::format("{:016x}", f.hash)}};
   return {{"nimbus", NIMBUS_VERSION}, {"scene", scene}, {"files", files}};
 }
 
+nlohmann::json render_fingerprint(const nlohmann::json& identity) {
+  return {{"nimbus", NIMBUS_VERSION}, {"scene", identity}, {"files", nlohmann::json::object()}};
+}
+
 std::string fingerprint_difference(const nlohmann::json& saved, const nlohmann::json& now) {
-  return difference(saved, now, "");
+  const auto without_files = [](nlohmann::json j) {
+    if (j.is_object()) j.erase("files");
+    return j;
+  };
+  if (std::string d = difference(without_files(saved), without_files(now), ""); !d.empty())
+    return d;
+  const auto files = [](const nlohmann::json& j) {
+    return j.is_object() && j.contains("files") && j["files"].is_object()
+               ? j["files"]
+               : nlohmann::json::object();
+  };
+  return file_difference(files(saved), files(now));
 }
 
 uint64_t majorant_hash(const Scene& scene) {
-  uint64_t h = hash_octree(scene.field_octree, 0xcbf29ce484222325ull);
+  uint64_t h = hash_octree(scene.field_octree, kFnvOffset);
   for (const MajorantOctree& t : scene.solid_octrees) h = hash_octree(t, h);
   return h;
 }

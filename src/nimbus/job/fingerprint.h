@@ -1,33 +1,28 @@
 #pragma once
 // What a checkpoint must match to be continued (job/checkpoint.h): everything that changes a
-// pixel's samples. The scene document after the --set overrides (--seed included), without
-// integrator.spp, which only says how many samples to take; the content of every file the loader
-// read for it (SceneDesc::inputs: VDB grids, wherever the document names them); the nimbus
-// version. Not the threads, the processes or the outputs, which change no pixel.
+// pixel's samples. The scene's document as loaded, after the --set overrides (--seed included),
+// without integrator.spp, which only says how many samples to take; the record of every file the
+// loader read for it (SceneDesc::inputs: VDB grids, wherever the document names them, with their
+// sizes and hashes taken as they were read); the nimbus version. Not the threads, the processes
+// or the outputs, which change no pixel. Nothing is read or parsed again.
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
-#include <span>
 #include <string>
-#include <vector>
 
 #include "nimbus/render/scene.h"
-#include "nimbus/scene/input_file.h"
+#include "nimbus/scene/scene_desc.h"
 
 namespace nimbus {
 
-// FNV-1a, 64 bits: a checksum, not a cryptographic hash.
-uint64_t hash_bytes(std::span<const std::byte> bytes, uint64_t h = 0xcbf29ce484222325ull);
+// The fingerprint of a loaded description. A description built in code has no document: pass
+// `identity`, any JSON that changes when the scene does, to stand for it.
+nlohmann::json render_fingerprint(const SceneDesc& desc);
+nlohmann::json render_fingerprint(const nlohmann::json& identity);
 
-// The fingerprint of a scene file loaded with these overrides, `inputs` being the files that
-// loading read (SceneDesc::inputs); call it once load_scene_file has accepted them (its errors
-// are a loader's: SceneError).
-nlohmann::json render_fingerprint(const std::string& scene_path,
-                                  const std::vector<std::string>& overrides,
-                                  const std::vector<InputFile>& inputs);
-
-// "" when equal; else the first difference, as "KEY: A in the checkpoint, B now" with KEY a
-// dotted path (integrator.seed, files./media/m/density/file).
+// "" when equal; else the first difference in words: "KEY: A in the checkpoint, B now" with KEY
+// a dotted path (scene.integrator.seed), or which file read by the scene is not the one the
+// checkpoint's render read.
 std::string fingerprint_difference(const nlohmann::json& saved, const nlohmann::json& now);
 
 // A hash of every majorant octree of the scene (nodes and bounds, to the bit): processes that

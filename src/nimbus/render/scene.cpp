@@ -78,7 +78,7 @@ void build_majorant_octrees(Scene& scene, const BuildMonitor& monitor) {
   std::vector<int> solids;
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const SceneObject& obj = scene.objects[i];
-    if (obj.medium >= 0 && obj.surface.type != Surface::Type::None)
+    if (has_own_octree(obj.medium, obj.surface.type))
       solids.push_back(static_cast<int>(i));
   }
   // Each tree gets an equal share of the progress: their costs are not known in advance.

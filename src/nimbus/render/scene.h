@@ -68,6 +68,13 @@ struct SceneObject {
   int medium = -1;
 };
 
+// Whether an object holding `medium` (an index, or -1) with a surface of this type has a majorant
+// octree of its own: a solid, whose medium a ray sees only inside it. Index-matched objects
+// (surface none) share the field's.
+inline bool has_own_octree(int medium, Surface::Type surface) {
+  return medium >= 0 && surface != Surface::Type::None;
+}
+
 struct Scene {
   Camera camera;
   RenderSettings settings;

@@ -22,20 +22,7 @@ Camera compile_camera(const CameraDesc& c, const FilmDesc& film) {
 
 Light compile_light(const LightDesc& d) {
   Light l;
-  switch (d.type) {
-    case LightDesc::Type::Environment:
-      l.type = Light::Type::Environment;
-      break;
-    case LightDesc::Type::Directional:
-      l.type = Light::Type::Directional;
-      break;
-    case LightDesc::Type::Point:
-      l.type = Light::Type::Point;
-      break;
-    case LightDesc::Type::Sphere:
-      l.type = Light::Type::Sphere;
-      break;
-  }
+  l.type = d.type;
   l.emission = d.type == LightDesc::Type::Directional ? d.irradiance
                : d.type == LightDesc::Type::Point     ? d.intensity
                                                       : d.radiance;
@@ -48,20 +35,7 @@ Light compile_light(const LightDesc& d) {
 
 Surface compile_surface(const SurfaceDesc& d) {
   Surface s;
-  switch (d.type) {
-    case SurfaceDesc::Type::None:
-      s.type = Surface::Type::None;
-      break;
-    case SurfaceDesc::Type::Diffuse:
-      s.type = Surface::Type::Diffuse;
-      break;
-    case SurfaceDesc::Type::Dielectric:
-      s.type = Surface::Type::Dielectric;
-      break;
-    case SurfaceDesc::Type::Emissive:
-      s.type = Surface::Type::Emissive;
-      break;
-  }
+  s.type = d.type;
   s.albedo = d.albedo;
   s.ior = d.ior;
   s.radiance = d.radiance;

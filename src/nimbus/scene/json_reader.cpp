@@ -138,7 +138,7 @@ std::string printable_line(std::string_view text) {
 }
 
 void JsonValue::record_input(const std::string& path) const {
-  if (origin_->inputs) origin_->inputs->push_back({pointer_, path});
+  if (origin_->inputs) origin_->inputs->push_back(record_input_file(pointer_, path));
 }
 
 void JsonValue::check(double x, const Range& range) const {

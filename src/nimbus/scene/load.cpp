@@ -724,6 +724,7 @@ SceneDesc load_json_in(nlohmann::json j, const std::string& source, const std::s
     origin.overrides.push_back({apply_override(j, o), set_flag(o)});
   SceneDesc scene = Loader(JsonValue(j, "", origin)).load();
   scene.inputs = std::move(inputs);
+  scene.document = std::move(j);
   return scene;
 }
 

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -46,7 +47,7 @@ using SpectrumDesc = SpectralSettings;
 // Colour inputs are SpectralParam: RGB (a number or [r, g, b]) or a curve from the file
 // ({"spectrum": [[nm, value], ...]}, or {"blackbody": K, "scale": s} where light is emitted).
 struct LightDesc {
-  enum class Type { Environment, Directional, Point, Sphere };
+  using Type = Light::Type;
   Type type = Type::Environment;
   SpectralParam radiance;    // environment, sphere
   SpectralParam irradiance;  // directional
@@ -74,7 +75,7 @@ struct MediumDesc {
 };
 
 struct SurfaceDesc {
-  enum class Type { None, Diffuse, Dielectric, Emissive };
+  using Type = Surface::Type;
   Type type = Type::Diffuse;
   SpectralParam albedo{Rgb(0.5)};  // diffuse
   double ior = 1.5;                // dielectric
@@ -101,6 +102,9 @@ struct SceneDesc {
   // Every file the description made the loader read, in the order read (not the scene file
   // itself): what a render's outputs must not overwrite.
   std::vector<InputFile> inputs;
+  // The document as loaded, after the overrides (null for a description built in code): with
+  // `inputs`, what the render is of (job/fingerprint.h), without a second parse.
+  nlohmann::json document;
 };
 
 }  // namespace nimbus

@@ -1,4 +1,4 @@
-#include "render_job.h"
+#include "nimbus/job/shared_render.h"
 
 #include <algorithm>
 #include <chrono>
@@ -11,15 +11,14 @@
 #include "nimbus/job/work_queue.h"
 #include "nimbus/render/renderer.h"
 
+namespace nimbus {
 namespace {
 
-using namespace nimbus;
 using Clock = std::chrono::steady_clock;
 
 // Message tags: a worker's report (its last unit's result, if any, and a request for the next;
-// or that it leaves the job), rank 0's reply (a unit, or the end of the job), and the exit code
-// at the very end.
-constexpr int kReportTag = 1, kReplyTag = 2, kExitTag = 3;
+// or that it leaves the job) and the lead's reply (a unit, or the end of the job).
+constexpr int kReportTag = 1, kReplyTag = 2;
 
 // A worker stopped by a signal gives back the unit it was rendering and leaves the job
 // (Abandoned); rank 0 finishes the job with the others, so a signal to one rank alone stops
@@ -80,15 +79,17 @@ double seconds_since(Clock::time_point t) {
 
 // Rank 0's main thread until the job is over: answers the other ranks' reports, draws the
 // progress, saves checkpoints.
-void serve(WorkQueue& queue, const Cluster& cluster, const JobSettings& s,
+void serve(WorkQueue& queue, JobChannel* channel, const SharedRenderSettings& s,
            const std::function<bool()>& stop) {
+  const int ranks = channel ? channel->size() : 1;
   std::vector<int> waiting;  // ranks that asked for a unit and have not had an answer
   int gone = 0;              // ranks that were told the job is over, or left it
   auto last_checkpoint = Clock::now();
   auto last_progress = Clock::time_point{};
   for (;;) {
     if (stop() && !queue.stopped()) queue.stop();
-    while (std::optional<ClusterMessage> m = cluster_poll(kReportTag)) {
+    while (std::optional<JobChannel::Message> m =
+               channel ? channel->poll(kReportTag) : std::nullopt) {
       Reader in{m->bytes};
       const auto kind = in.get<Report>();
       if (kind == Report::Result || kind == Report::Abandoned) {
@@ -118,7 +119,7 @@ void serve(WorkQueue& queue, const Cluster& cluster, const JobSettings& s,
         ++it;
         continue;
       }
-      cluster_send(*it, kReplyTag, out.bytes);
+      channel->send(*it, kReplyTag, out.bytes);
       it = waiting.erase(it);
     }
     if (s.progress && seconds_since(last_progress) > 0.1) {
@@ -129,20 +130,22 @@ void serve(WorkQueue& queue, const Cluster& cluster, const JobSettings& s,
       queue.with_film(s.checkpoint);
       last_checkpoint = Clock::now();
     }
-    if (over && queue.none_out() && gone == cluster.size - 1) break;
+    if (over && queue.none_out() && gone == ranks - 1) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
 }
 
 }  // namespace
 
-JobResult lead_job(const Scene& scene, const Cluster& cluster, JobSettings s) {
+SharedRenderResult lead_shared_render(const Scene& scene, JobChannel* channel,
+                                      SharedRenderSettings s) {
+  const int ranks = channel ? channel->size() : 1;
   const auto start = Clock::now();
   const int H = scene.settings.height;
   // Four bands per rank at least, so every rank has lanes to take; at most 16 rows (the
   // renderer's tile), so the bands of a dense region are short.
-  const int band_height = std::clamp(H / (4 * cluster.size), 1, 16);
-  WorkQueue queue(std::move(s.start), s.spp, band_height, cluster.size, s.unit_seconds);
+  const int band_height = std::clamp(H / (4 * ranks), 1, 16);
+  WorkQueue queue(std::move(s.start), s.spp, band_height, ranks, s.unit_seconds);
   const auto stop = [&] { return s.stop && s.stop(); };
 
   std::exception_ptr local_failure;
@@ -163,7 +166,7 @@ JobResult lead_job(const Scene& scene, const Cluster& cluster, JobSettings s) {
   });
 
   try {
-    serve(queue, cluster, s, stop);
+    serve(queue, channel, s, stop);
   } catch (...) {
     queue.stop();
     local.join();
@@ -172,7 +175,7 @@ JobResult lead_job(const Scene& scene, const Cluster& cluster, JobSettings s) {
   local.join();
   if (local_failure) std::rethrow_exception(local_failure);
 
-  JobResult result;
+  SharedRenderResult result;
   result.stopped = !queue.finished();
   if (s.progress && !result.stopped) s.progress(1.0);
   if (s.checkpoint) queue.with_film(s.checkpoint);
@@ -183,13 +186,14 @@ JobResult lead_job(const Scene& scene, const Cluster& cluster, JobSettings s) {
   return result;
 }
 
-void work_on_job(const Scene& scene, int threads, const std::function<bool()>& stop) {
+void work_on_shared_render(const Scene& scene, JobChannel& channel, int threads,
+                           const std::function<bool()>& stop) {
   Film scratch(scene.settings.width, scene.settings.height);
   Writer report;
   report.put(Report::Request);
   for (;;) {
-    cluster_send(0, kReportTag, report.bytes);
-    const ClusterMessage m = cluster_receive(0, kReplyTag);
+    channel.send(0, kReportTag, report.bytes);
+    const JobChannel::Message m = channel.receive(0, kReplyTag);
     Reader in{m.bytes};
     if (in.get<Reply>() == Reply::Done) return;
     const auto unit = in.get<WorkUnit>();
@@ -200,7 +204,7 @@ void work_on_job(const Scene& scene, int threads, const std::function<bool()>& s
       report.put(unit);
       report.put(r.stats.seconds);
       report.put(r.stats.counters);
-      cluster_send(0, kReportTag, report.bytes);
+      channel.send(0, kReportTag, report.bytes);
       return;
     }
     report.put(Report::Result);
@@ -212,13 +216,4 @@ void work_on_job(const Scene& scene, int threads, const std::function<bool()>& s
   }
 }
 
-void send_exit_code(const Cluster& cluster, int code) {
-  Writer out;
-  out.put(int32_t(code));
-  for (int r = 1; r < cluster.size; ++r) cluster_send(r, kExitTag, out.bytes);
-}
-
-int receive_exit_code() {
-  const ClusterMessage m = cluster_receive(0, kExitTag);
-  return Reader{m.bytes}.get<int32_t>();
-}
+}  // namespace nimbus

@@ -1,0 +1,241 @@
+#include "nimbus/job/render_job.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <memory>
+#include <thread>
+
+#include "nimbus/job/fingerprint.h"
+#include "nimbus/job/shared_render.h"
+#include "nimbus/render/memory_estimate.h"
+#include "nimbus/render/path_spectra.h"
+#include "nimbus/render/renderer.h"
+#include "nimbus/render/stats.h"
+#include "nimbus/scene/compile.h"
+#include "nimbus/scene/load.h"
+
+namespace nimbus {
+
+RenderJob::RenderJob(RenderJobOptions options)
+    : options_(std::move(options)),
+      checkpoint_file_(!options_.checkpoint.empty() ? options_.checkpoint : options_.resume) {
+  if (options_.spp < 0) throw std::invalid_argument("spp must be >= 0");
+  if (!(options_.checkpoint_interval > 0))
+    throw std::invalid_argument("the checkpoint interval must be > 0 seconds");
+}
+
+void RenderJob::prepare(const std::string& scene_file, const BuildMonitor& monitor) {
+  load(scene_file, read_resume());
+  check();
+  if (!compile(monitor)) return;
+  check_majorants();
+}
+
+int RenderJob::read_resume() {
+  if (options_.resume.empty()) return options_.spp;
+  try {
+    resumed_ = load_checkpoint(options_.resume);
+  } catch (const std::runtime_error& e) {
+    throw JobError(fmt::format("--resume: {}", e.what()));
+  }
+  // Without an spp, a resumed render finishes what the checkpoint's render was asked for.
+  return options_.spp > 0 ? options_.spp : resumed_->spp;
+}
+
+void RenderJob::load(const std::string& scene_file, int spp) {
+  std::vector<std::string> overrides = options_.overrides;
+  if (spp > 0) overrides.push_back(fmt::format("integrator.spp={}", spp));
+  if (options_.seed) overrides.push_back(fmt::format("integrator.seed={}", *options_.seed));
+  desc_ = load_scene_file(scene_file, overrides);
+  scene_file_ = scene_file;
+  fingerprint_ = render_fingerprint(desc_);
+  compiled_ = false;
+}
+
+void RenderJob::set_scene(Scene scene, const nlohmann::json& identity) {
+  if (!options_.overrides.empty() || options_.seed)
+    throw std::invalid_argument(
+        "a scene built in code takes no overrides and no seed: set them in its settings");
+  const int spp = read_resume();
+  scene_ = std::move(scene);
+  if (spp > 0) scene_.settings.spp = spp;
+  fingerprint_ = render_fingerprint(nlohmann::json{{"scene", identity},
+                                                   {"seed", scene_.settings.seed},
+                                                   {"max_depth", scene_.settings.max_depth}});
+  compiled_ = true;
+  check();
+  check_majorants();
+}
+
+void RenderJob::check() const {
+  const int width = compiled_ ? scene_.settings.width : desc_.film.width;
+  const int height = compiled_ ? scene_.settings.height : desc_.film.height;
+  const int spp = compiled_ ? scene_.settings.spp : desc_.integrator.spp;
+  if (resumed_) {
+    const std::string& file = options_.resume;
+    if (const std::string d = fingerprint_difference(resumed_->fingerprint, fingerprint_);
+        !d.empty())
+      throw JobError(fmt::format(
+          "--resume {}: the checkpoint is of another scene or other settings ({})", file, d));
+    if (resumed_->film.width != width || resumed_->film.height != height)
+      throw JobError(fmt::format("--resume {}: a film of {}x{} pixels, the scene's image is {}x{}",
+                                 file, resumed_->film.width, resumed_->film.height, width, height));
+    const uint32_t most =
+        *std::max_element(resumed_->film.samples.begin(), resumed_->film.samples.end());
+    if (most > uint32_t(spp))
+      throw JobError(
+          fmt::format("--resume {}: pixels of the checkpoint hold {} samples, more than --spp {}",
+                      file, most, spp));
+  }
+  // A scene built in code holds its octrees already: only a description's render is estimated.
+  if (!compiled_) check_render_memory(desc_, options_.threads, options_.max_memory);
+}
+
+bool RenderJob::compile(const BuildMonitor& monitor) {
+  scene_ = compile_scene(desc_, monitor);
+  compiled_ = !(monitor.cancel && monitor.cancel());
+  return compiled_;
+}
+
+void RenderJob::check_majorants() const {
+  if (resumed_ && resumed_->majorants != majorant_hash(scene_))
+    throw JobError(fmt::format(
+        "--resume {}: the checkpoint's majorant octrees differ from this render's (another "
+        "nimbus build?)",
+        options_.resume));
+}
+
+JobOutcome RenderJob::run(JobChannel* channel) {
+  if (!compiled_) throw std::logic_error("RenderJob::run before the scene was compiled");
+  // One call of the renderer, over tiles, unless units must be shared or checkpointed.
+  if (!channel && checkpoint_file_.empty()) return run_at_once();
+  return run_shared(channel);
+}
+
+JobOutcome RenderJob::run_at_once() {
+  RenderOptions render_options;
+  render_options.threads = options_.threads;
+  render_options.cancel = options_.cancel;
+  render_options.progress = options_.progress;
+  RenderResult r = render(scene_, render_options);
+  JobOutcome outcome;
+  outcome.stopped = r.cancelled || (options_.cancel && options_.cancel());
+  outcome.film = std::move(r.film);
+  outcome.counters = r.counters;
+  outcome.seconds = r.seconds;
+  outcome.threads = r.threads;
+  return outcome;
+}
+
+JobOutcome RenderJob::run_shared(JobChannel* channel) {
+  SharedRenderSettings s;
+  s.spp = scene_.settings.spp;
+  s.threads = options_.threads;
+  s.start = resumed_ ? resumed_->film : Film(scene_.settings.width, scene_.settings.height);
+  const uint64_t held_at_start = samples_held(s.start);
+  // Why the last checkpoint could not be saved; empty: it was, or none was due.
+  auto failure = std::make_shared<std::string>();
+  if (!checkpoint_file_.empty()) {
+    Checkpoint header;
+    header.fingerprint = fingerprint_;
+    header.majorants = majorant_hash(scene_);
+    header.spp = scene_.settings.spp;
+    s.checkpoint_interval = options_.checkpoint_interval;
+    // Units are short next to the interval, so checkpoints come on time.
+    s.unit_seconds = std::min(s.unit_seconds, s.checkpoint_interval / 4);
+    s.checkpoint = [header, path = checkpoint_file_, held_at_start, failure,
+                    warn = options_.warning](const Film& film) mutable {
+      // Nothing rendered yet: the file would gain nothing, and a fresh render's checkpoint
+      // would replace an earlier one with an empty film.
+      if (samples_held(film) == held_at_start) return;
+      header.film = film;
+      try {
+        save_checkpoint(header, path);
+        failure->clear();
+      } catch (const std::exception& e) {
+        *failure = e.what();
+        if (warn) warn(fmt::format("--checkpoint: {} (not saved)", e.what()));
+      }
+    };
+  }
+  s.progress = options_.progress;
+  s.stop = options_.cancel;
+  SharedRenderResult r = lead_shared_render(scene_, channel, std::move(s));
+  JobOutcome outcome;
+  outcome.film = std::move(r.film);
+  outcome.counters = r.counters;
+  outcome.seconds = r.seconds;
+  outcome.threads =
+      options_.threads > 0 ? options_.threads : int(std::thread::hardware_concurrency());
+  outcome.processes = channel ? channel->size() : 1;
+  if (channel) outcome.samples_per_rank = std::move(r.samples_per_rank);
+  outcome.samples_at_start = held_at_start;
+  outcome.stopped = r.stopped;
+  outcome.checkpoint_failure = *failure;
+  return outcome;
+}
+
+void RenderJob::work(JobChannel& channel) {
+  if (!compiled_) throw std::logic_error("RenderJob::work before the scene was compiled");
+  work_on_shared_render(scene_, channel, options_.threads, options_.cancel);
+}
+
+nlohmann::json RenderJob::stats(const JobOutcome& outcome) const {
+  RenderResult result;
+  result.film = outcome.film;
+  result.counters = outcome.counters;
+  result.seconds = outcome.seconds;
+  result.threads = outcome.threads;
+  nlohmann::json j = render_stats(scene_, result, scene_file_);
+  if (!outcome.samples_per_rank.empty())
+    j["mpi"] = {{"ranks", outcome.processes}, {"samples_per_rank", outcome.samples_per_rank}};
+  if (!checkpoint_file_.empty())
+    j["checkpoint"] = {{"file", checkpoint_file_},
+                       {"samples_at_start", outcome.samples_at_start},
+                       {"samples", samples_held(outcome.film)}};
+  return j;
+}
+
+std::string RenderJob::summary(const JobOutcome& outcome) const {
+  const RenderSettings& s = scene_.settings;
+  const double samples = double(samples_held(outcome.film) - outcome.samples_at_start);
+  std::string where = fmt::format("{} threads", outcome.threads);
+  if (outcome.processes > 1) where += fmt::format(" x {} processes", outcome.processes);
+  return fmt::format("{}x{}, {} spp in {:.2f} s ({:.3g} samples/s, {})", s.width, s.height, s.spp,
+                     outcome.seconds, outcome.seconds > 0 ? samples / outcome.seconds : 0.0, where);
+}
+
+std::vector<NamedFile> RenderJob::files_read() const {
+  std::vector<NamedFile> read;
+  if (!scene_file_.empty()) read.push_back({"the scene file", scene_file_});
+  for (const InputFile& f : desc_.inputs) read.push_back({"the file of " + f.pointer, f.path});
+  if (!options_.resume.empty() && !options_.checkpoint.empty() &&
+      !same_file(options_.resume, options_.checkpoint))
+    read.push_back({"the checkpoint of --resume", options_.resume});
+  return read;
+}
+
+std::vector<NamedFile> RenderJob::files_written() const {
+  if (!options_.checkpoint.empty()) return {{"--checkpoint", options_.checkpoint}};
+  if (!options_.resume.empty()) return {{"--resume (its later checkpoints)", options_.resume}};
+  return {};
+}
+
+void check_render_memory(const SceneDesc& desc, int threads, std::optional<uint64_t> max_memory) {
+  int octrees = 1;  // the field's, and one per solid holding a medium (render/scene.h)
+  for (const ObjectDesc& o : desc.objects) octrees += has_own_octree(o.medium, o.surface.type);
+  const int bins = desc.spectrum.mode == SpectralSettings::Mode::Spectral ? kSpectralBins : 3;
+  const int workers = threads > 0 ? threads : int(std::thread::hardware_concurrency());
+  const MemoryEstimate need =
+      estimate_render_memory(desc.film.width, desc.film.height, octrees, bins, workers);
+  const uint64_t limit = max_memory ? *max_memory : available_memory();
+  if (limit > 0 && need.total() > double(limit))
+    throw JobError(fmt::format(
+        "the render needs about {} (film {}, image {}, majorant octrees {}), more than the {} {}",
+        format_memory(need.total()), format_memory(need.film), format_memory(need.image),
+        format_memory(need.octrees), format_memory(double(limit)),
+        max_memory ? "allowed by --max-memory" : "available"));
+}
+
+}  // namespace nimbus

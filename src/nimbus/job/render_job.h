@@ -1,0 +1,133 @@
+#pragma once
+// A render as a job: what a render is beyond render_into (render/renderer.h). It loads the scene
+// with its overrides, continues a checkpoint after checking that it is of this scene, refuses a
+// render the machine cannot hold, compiles, renders with progress and cancellation, saves
+// checkpoints on an interval and when stopped, shares the work with other processes
+// (job/job_channel.h), and reports the summary and the --stats JSON. `nimbus render` is this job
+// driven from the command line; a program embedding nimbus, or a binding, drives the same job.
+//
+//   RenderJob job(options);            // spp, seed, threads, checkpoint, resume, callbacks
+//   job.prepare("scene.json");         // or set_scene(scene, identity) for a scene built in code
+//   JobOutcome r = job.run();          // r.film; r.stopped if cancelled
+//
+// Processes of one job call the steps of prepare themselves, agreeing between them: the lead
+// (rank 0) alone reads the checkpoint (read_resume) and checks (check); every process loads and
+// compiles; the lead runs, the others work.
+
+#include <cstdint>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "nimbus/io/output.h"
+#include "nimbus/job/checkpoint.h"
+#include "nimbus/job/job_channel.h"
+#include "nimbus/media/build_monitor.h"
+#include "nimbus/render/counters.h"
+#include "nimbus/render/film.h"
+#include "nimbus/render/scene.h"
+#include "nimbus/scene/scene_desc.h"
+
+namespace nimbus {
+
+// A request the job refuses before rendering (a checkpoint of another scene, more memory than
+// allowed): one line, the command line's exit 2. Problems of the scene file are SceneError.
+struct JobError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct RenderJobOptions {
+  std::vector<std::string> overrides;  // scene keys set as KEY=VALUE (--set), in order
+  int spp = 0;                      // > 0: overrides integrator.spp; 0: the scene's, or resuming,
+                                    // the spp the checkpoint's render was asked for
+  std::optional<uint64_t> seed;     // overrides integrator.seed
+  int threads = 0;                  // per process; 0: all cores
+  std::string checkpoint;           // where the job's state is saved; "": none, or resuming, there
+  double checkpoint_interval = 60;  // seconds between checkpoints
+  std::string resume;               // a checkpoint to continue
+  std::optional<uint64_t> max_memory;    // bytes; none: the memory the system has available
+  std::function<void(double)> progress;  // the fraction done, now and then
+  std::function<bool()> cancel;          // polled; true stops the job
+  std::function<void(const std::string&)> warning;  // a problem the job survives, one line
+};
+
+struct JobOutcome {
+  Film film;  // every pixel at spp, or stopped: the samples done (whole units with checkpoints)
+  Counters counters;
+  double seconds = 0;
+  int threads = 0;  // per process
+  int processes = 1;
+  std::vector<uint64_t> samples_per_rank;  // several processes: pixel samples each rendered
+  uint64_t samples_at_start = 0;           // in the resumed film
+  bool stopped = false;                    // cancelled before every pixel reached spp
+  // Why the last checkpoint due could not be saved; "": saved, or none was due.
+  std::string checkpoint_failure;
+};
+
+class RenderJob {
+ public:
+  explicit RenderJob(RenderJobOptions options);
+
+  // read_resume (lead), load, check (lead) and compile, for a job in one process.
+  void prepare(const std::string& scene_file, const BuildMonitor& monitor = {});
+  // A scene built in code (compiled, finish_scene called) instead of a file: `identity`, any
+  // JSON that changes when the scene does, stands for the scene in checkpoints. Checks as check.
+  void set_scene(Scene scene, const nlohmann::json& identity);
+
+  // The lead's: reads the checkpoint to continue, if any, and returns the spp to render to
+  // (0: the scene's), which every process must load with. JobError for a bad checkpoint.
+  int read_resume();
+  // Loads the scene file with the overrides, `spp` (if > 0) and the seed. SceneError.
+  void load(const std::string& scene_file, int spp);
+  // The lead's: the checkpoint to continue is of this scene, and the memory suffices. JobError.
+  void check() const;
+  // Compiles the scene (reads its files, builds the majorant octrees); false if the monitor
+  // cancelled it. SceneError.
+  bool compile(const BuildMonitor& monitor = {});
+  // The lead's, once compiled: the resumed checkpoint's octrees are this scene's. JobError.
+  void check_majorants() const;
+
+  // The lead's (rank 0 of `channel`, or the only process): renders to spp.
+  JobOutcome run(JobChannel* channel = nullptr);
+  // Every other process's: renders the units the lead hands out until the job is over.
+  void work(JobChannel& channel);
+
+  // What --stats writes for an outcome (render/stats.h, with the processes and the checkpoint).
+  nlohmann::json stats(const JobOutcome& outcome) const;
+  // "64x48, 16 spp in 0.52 s (9.1e+04 samples/s, 2 threads)", with the processes if several.
+  std::string summary(const JobOutcome& outcome) const;
+
+  // The files the job reads (the scene file, those its description named, the checkpoint it
+  // continues) and writes (checkpoints), for io/output.h's check_outputs_distinct.
+  std::vector<NamedFile> files_read() const;
+  std::vector<NamedFile> files_written() const;
+
+  const SceneDesc& description() const { return desc_; }
+  const Scene& scene() const { return scene_; }
+  const RenderJobOptions& options() const { return options_; }
+  // Where checkpoints are saved: --checkpoint, or else the file resumed; "": none.
+  const std::string& checkpoint_file() const { return checkpoint_file_; }
+
+ private:
+  JobOutcome run_at_once();
+  JobOutcome run_shared(JobChannel* channel);
+
+  RenderJobOptions options_;
+  std::string checkpoint_file_;
+  std::string scene_file_;
+  std::optional<Checkpoint> resumed_;
+  SceneDesc desc_;
+  Scene scene_;
+  nlohmann::json fingerprint_;
+  bool compiled_ = false;
+};
+
+// Memory the job's render needs, against `max_memory` (or the available memory when none):
+// JobError with the estimate's parts when it does not fit. `octrees` as Scene's rule
+// (solid_octree_count).
+void check_render_memory(const SceneDesc& desc, int threads, std::optional<uint64_t> max_memory);
+
+}  // namespace nimbus
