@@ -10,6 +10,7 @@
 #include "nimbus/frep/tape.h"
 #include "nimbus/math/constants.h"
 #include "nimbus/render/renderer.h"
+#include "nimbus/scene/compile.h"
 #include "support/stats.h"
 
 namespace nimbus {
@@ -31,6 +32,7 @@ Scene sphere_scene(const Surface& surface, int size, int spp) {
   env.type = Light::Type::Environment;
   env.emission = Rgb(1.0);
   scene.lights.push_back(env);
+  finish_scene(scene);
   return scene;
 }
 
@@ -92,6 +94,7 @@ TEST(Render, ImageIsBitIdenticalForAnyThreadCount) {
   sun.direction = normalize(Vec3{-1, -1, -1});
   sun.emission = Rgb(2.0);
   scene.lights.push_back(sun);
+  finish_scene(scene);
   const RenderResult one = render(scene, RenderOptions{1, {}, {}, {}});
   const RenderResult two = render(scene, RenderOptions{2, {}, {}, {}});
   ASSERT_EQ(one.film.sum.size(), two.film.sum.size());
@@ -152,6 +155,7 @@ void expect_lights_on_floor(TrackingSettings::Mode mode, bool more_lights,
     sky.emission = Rgb(L_env);
     scene.lights.insert(scene.lights.end(), {sun, bulb, sky});
   }
+  finish_scene(scene);
   const RenderResult res = render(scene);
 
   double chi2 = 0;

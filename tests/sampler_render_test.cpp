@@ -135,6 +135,7 @@ Scene lit_floor(Sampler sampler, uint64_t seed) {
   light.radius = kLightR;
   light.emission = Rgb(kLightL);
   scene.lights.push_back(light);
+  finish_scene(scene);
   return scene;
 }
 

@@ -24,6 +24,10 @@ RenderRange resolve(const Scene& scene, const Film& film, RenderRange r) {
   if (film.width != W || film.height != H)
     throw std::invalid_argument(fmt::format("the film is {}x{} pixels, the scene's image {}x{}",
                                             film.width, film.height, W, H));
+  if (scene.surfaces.object_count != scene.objects.size() ||
+      scene.surfaces.light_count != scene.lights.size())
+    throw std::invalid_argument(
+        "the scene's objects or lights changed since finish_scene: call it again");
   if (r.x1 < 0) r.x1 = W;
   if (r.y1 < 0) r.y1 = H;
   if (r.s1 < 0) r.s1 = scene.settings.spp;

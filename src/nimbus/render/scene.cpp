@@ -4,41 +4,47 @@
 
 namespace nimbus {
 
+SurfaceIndex build_surface_index(const std::vector<SceneObject>& objects,
+                                 const std::vector<Light>& lights) {
+  SurfaceIndex index;
+  for (size_t i = 0; i < objects.size(); ++i)
+    if (objects[i].surface.type != Surface::Type::None) index.objects.push_back(int(i));
+  for (size_t i = 0; i < lights.size(); ++i)
+    if (lights[i].type == Light::Type::Sphere) index.lights.push_back(int(i));
+  index.object_count = objects.size();
+  index.light_count = lights.size();
+  return index;
+}
+
 std::optional<SurfaceHit> intersect(const Scene& scene, const Ray& ray, double t_max) {
   std::optional<SurfaceHit> best;
-  for (size_t i = 0; i < scene.objects.size(); ++i) {
+  for (const int i : scene.surfaces.objects) {
     const SceneObject& obj = scene.objects[i];
-    if (obj.surface.type == Surface::Type::None) continue;
     double t0 = 0, t1 = t_max;
     if (!clip_ray(obj.bounds, ray, t0, t1)) continue;
     if (auto t = first_hit(obj.tape, ray, t0, t1)) {
       t_max = *t;
-      best = SurfaceHit{*t, static_cast<int>(i), -1};
+      best = SurfaceHit{*t, i, -1};
     }
   }
-  for (size_t i = 0; i < scene.lights.size(); ++i) {
-    if (scene.lights[i].type != Light::Type::Sphere) continue;
+  for (const int i : scene.surfaces.lights) {
     if (auto t = intersect_sphere_light(scene.lights[i], ray, 0, t_max)) {
       t_max = *t;
-      best = SurfaceHit{*t, -1, static_cast<int>(i)};
+      best = SurfaceHit{*t, -1, i};
     }
   }
   return best;
 }
 
 bool occluded(const Scene& scene, const Ray& ray, double t_max, int target_light) {
-  for (const SceneObject& obj : scene.objects) {
-    if (obj.surface.type == Surface::Type::None) continue;
+  for (const int i : scene.surfaces.objects) {
+    const SceneObject& obj = scene.objects[i];
     double t0 = 0, t1 = t_max;
     if (!clip_ray(obj.bounds, ray, t0, t1)) continue;
     if (first_hit(obj.tape, ray, t0, t1)) return true;
   }
-  for (int i = 0; i < static_cast<int>(scene.lights.size()); ++i) {
-    const Light& l = scene.lights[i];
-    if (i != target_light && l.type == Light::Type::Sphere &&
-        intersect_sphere_light(l, ray, 0, t_max))
-      return true;
-  }
+  for (const int i : scene.surfaces.lights)
+    if (i != target_light && intersect_sphere_light(scene.lights[i], ray, 0, t_max)) return true;
   return false;
 }
 
@@ -78,8 +84,7 @@ void build_majorant_octrees(Scene& scene, const BuildMonitor& monitor) {
   std::vector<int> solids;
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const SceneObject& obj = scene.objects[i];
-    if (has_own_octree(obj.medium, obj.surface.type))
-      solids.push_back(static_cast<int>(i));
+    if (has_own_octree(obj.medium, obj.surface.type)) solids.push_back(static_cast<int>(i));
   }
   // Each tree gets an equal share of the progress: their costs are not known in advance.
   const double trees = double(solids.size() + 1);

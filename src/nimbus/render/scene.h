@@ -14,6 +14,7 @@
 #include "nimbus/render/camera.h"
 #include "nimbus/render/light.h"
 #include "nimbus/render/material.h"
+#include "nimbus/render/surface_index.h"
 
 namespace nimbus {
 
@@ -86,7 +87,8 @@ struct Scene {
   // object holding a medium (indexed by object; empty for the others).
   MajorantOctree field_octree;
   std::vector<MajorantOctree> solid_octrees;
-  double scale = 1;  // size of the scene's bounds, for ray offsets
+  SurfaceIndex surfaces;  // what `intersect` and `occluded` search (finish_scene builds it)
+  double scale = 1;       // size of the scene's bounds, for ray offsets
 };
 
 struct SurfaceHit {

@@ -168,6 +168,7 @@ void finish_scene(Scene& scene, const BuildMonitor& monitor) {
         fmt::format("{} index-matched medium objects; at most {} are supported",
                     scene.field_objects.size(), kMaxMediaAtPoint));
   if (!all.empty()) scene.scale = length(all.extent());
+  scene.surfaces = build_surface_index(scene.objects, scene.lights);
   complete_spectra(scene);
   build_majorant_octrees(scene, monitor);
 }
