@@ -1,8 +1,8 @@
 #pragma once
 // The path tracer: radiance arriving along a camera ray, at a path's N channels
 // (render/path_spectra.h). One path loop for every tracking mode, which is a policy
-// (render/tracking_policies.h). Instantiated once per channel count
-// (render/render_channels.cpp.in).
+// (render/tracking_policies.h). Instantiated per channel count (render/render_channels.cpp.in)
+// and per policy (with_tracking_policy).
 
 #include <algorithm>
 #include <array>
@@ -143,12 +143,16 @@ PhaseSample<N> draw_phase(const MediumPoint<N>& m, const Vec3& dir, PathSampler&
   return ps;
 }
 
+}  // namespace integrator_detail
+
 // The one path loop: radiance along a camera ray, with the tracking mode's policy
 // (tracking_policies.h) for what differs between modes. Each bounce takes its numbers from its
 // block of the sampler's dimensions (SampleDims), the tracking estimators from the path's stream.
 template <int N, class Policy>
 Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, PathSampler& sampler,
                        Counters& counters, Policy& policy) {
+  using namespace integrator_detail;
+  ++counters.paths;
   Rng& rng = sampler.rng();
   const int slots = light_slots(scene);  // per bounce, in the sampler's dimensions
   Spectrum<N> L(0.0);
@@ -238,21 +242,6 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
     if (!policy.roulette(depth, roulette_u)) break;
   }
   return L;
-}
-
-}  // namespace integrator_detail
-
-template <int N>
-Spectrum<N> radiance(const Scene& scene, const PathSpectra<N>& ps, Ray ray, PathSampler& sampler,
-                     Counters& counters) {
-  using namespace integrator_detail;
-  ++counters.paths;
-  if (scene.settings.tracking.mode == TrackingSettings::Mode::SpectralMis) {
-    HeroTracking<N> policy(sampler.get1d(SampleDims::kHero));
-    return trace_path(scene, ps, ray, sampler, counters, policy);
-  }
-  PlainTracking<N> policy;
-  return trace_path(scene, ps, ray, sampler, counters, policy);
 }
 
 }  // namespace nimbus

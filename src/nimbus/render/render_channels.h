@@ -21,10 +21,10 @@
 namespace nimbus {
 
 // Adds the samples [range.s0, range.s1) of the pixels of `range` (resolved and checked by
-// render_into) to the film.
-template <int N>
-RenderStats render_channels(const Scene& scene, Film& film, const RenderRange& range,
-                            const RenderOptions& options, int threads) {
+// render_into) to the film, each path with a fresh policy from `make_policy`.
+template <int N, class MakePolicy>
+RenderStats render_tiles(const Scene& scene, Film& film, const RenderRange& range,
+                         const RenderOptions& options, int threads, const MakePolicy& make_policy) {
   const int W = scene.settings.width;
   RenderStats stats;
   stats.threads = threads;
@@ -57,7 +57,8 @@ RenderStats render_channels(const Scene& scene, Film& film, const RenderRange& r
               const std::array<double, 2> u = sampler.get2d(SampleDims::kCamera);
               const Ray ray = scene.camera.generate(x + u[0], y + u[1]);
               if (spectral) prepare_path_spectra(ps, scene, sampler.get1d(SampleDims::kWavelength));
-              const Spectrum<N> L = radiance(scene, ps, ray, sampler, local);
+              auto policy = make_policy(sampler);
+              const Spectrum<N> L = trace_path(scene, ps, ray, sampler, local, policy);
               if (!film.add(pixel, to_film_rgb(L, ps.ch))) ++local.rejected_samples;
             }
           }
@@ -72,6 +73,15 @@ RenderStats render_channels(const Scene& scene, Film& film, const RenderRange& r
   for (const Counters& c : counters) stats.counters += c;
   stats.cancelled = cancelled;
   return stats;
+}
+
+// render_tiles with the policy of the scene's tracking mode, resolved once (with_tracking_policy).
+template <int N>
+RenderStats render_channels(const Scene& scene, Film& film, const RenderRange& range,
+                            const RenderOptions& options, int threads) {
+  return with_tracking_policy<N>(scene.settings.tracking, [&](const auto& make_policy) {
+    return render_tiles<N>(scene, film, range, options, threads, make_policy);
+  });
 }
 
 }  // namespace nimbus

@@ -6,19 +6,23 @@
 // throughput at a scattering vertex, and Russian roulette. Everything else (surfaces, lights,
 // phase sampling, the order of random numbers) is the loop's, once.
 //
-// - PlainTracking: delta tracking, spectral-max and spectral-history (one throughput beta;
-//   power-heuristic MIS between light sampling and BSDF or phase sampling).
+// - PlainTracking<N, Flight>: delta tracking, spectral-max and spectral-history (one throughput
+//   beta; power-heuristic MIS between light sampling and BSDF or phase sampling), with the
+//   free-path estimator Flight (render/volume.h: Woodcock, decomposition or weighted tracking).
 // - HeroTracking: null-scattering spectral MIS (Miller et al. 2019): a hero channel per path,
 //   path pdfs r_u and r_l, the balance heuristic over channels and techniques.
 //
-// Adding a tracking mode: a policy with these members (docs/architecture.md), a name in
-// render/setting_names.h, and its dispatch in radiance().
+// A render's tracking settings are resolved once, by with_tracking_policy, into the policy type
+// its paths run with; the path loop is instantiated per policy. Adding a tracking mode: a policy
+// with these members (docs/architecture.md), a name in render/setting_names.h, and its case in
+// with_tracking_policy.
 
 #include <algorithm>
 
 #include "nimbus/math/rng.h"
 #include "nimbus/render/counters.h"
 #include "nimbus/render/light.h"
+#include "nimbus/render/path_sampler.h"
 #include "nimbus/render/path_spectra.h"
 #include "nimbus/render/sampling.h"
 #include "nimbus/render/scene.h"
@@ -38,15 +42,20 @@ bool russian_roulette(Spectrum<N>& beta, double scale, int depth, U&& u) {
   return true;
 }
 
-template <int N>
+template <int N, class Flight>
 class PlainTracking {
  public:
+  // The rule and absorption events of the render's mode; the Channel rule's channel is the
+  // path's, chosen where it first meets a medium.
+  explicit PlainTracking(const EventPolicy& events) : events_(events) { events_.channel = -1; }
+
   // The path throughput, which multiplies next-event estimates.
   const Spectrum<N>& throughput() const { return beta_; }
 
   MediumEvent<N> collide(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray, double t_max,
                          int inside, Rng& rng, Counters& counters) {
-    return sample_collision(scene, ps, ray, t_max, inside, beta_, channel_, boost_, rng, counters);
+    return sample_collision<N, Flight>(scene, ps, ray, t_max, inside, events_, beta_, boost_, rng,
+                                       counters);
   }
 
   // Next-event estimation of one light sample `ls` along `shadow` (to t_max): fLi is the
@@ -56,8 +65,8 @@ class PlainTracking {
   bool light_term(const Scene& scene, const PathSpectra<N>& ps, const Ray& shadow, double t_max,
                   int light, int inside, const LightSample& ls, const Spectrum<N>& fLi, Pdf&& f_pdf,
                   Rng& rng, Counters& counters, Spectrum<N>& out) const {
-    const Spectrum<N> T = transmittance(scene, ps, shadow, t_max, light, inside, channel_, boost_,
-                                        beta_ * fLi, rng, counters);
+    const Spectrum<N> T = transmittance(scene, ps, shadow, t_max, light, inside, events_.channel,
+                                        boost_, beta_ * fLi, rng, counters);
     if (T.is_black()) return false;
     out = ls.delta ? fLi * T : fLi * T * (power_heuristic(ls.pdf, f_pdf(ls.wi)) / ls.pdf);
     return true;
@@ -88,9 +97,10 @@ class PlainTracking {
 
  private:
   Spectrum<N> beta_{1.0};
-  // Delta tracking follows one channel per path, chosen uniformly when the path first meets a
-  // medium (sample_collision), and from then on carries its weight (times N) in that channel.
-  int channel_ = -1;
+  // Delta tracking (the Channel rule) follows one channel per path, events_.channel, chosen
+  // uniformly when the path first meets a medium (sample_collision), and from then on carries
+  // its weight (times N) in that channel; -1 until then, and for the other rules.
+  EventPolicy events_;
   double prev_pdf_ = 0;  // solid-angle pdf with which the current direction was sampled
   double boost_ = 1;     // the path's majorant boost (volume.h)
 };
@@ -157,5 +167,34 @@ class HeroTracking {
   MisPath<N> path_;
   double boost_ = 1;  // the path's majorant boost (volume.h)
 };
+
+// The collision rule and absorption events of a plain mode (not spectral-mis).
+inline EventPolicy event_policy(const TrackingSettings& t) {
+  using Mode = TrackingSettings::Mode;
+  EventPolicy events;
+  events.rule = t.mode == Mode::Delta             ? EventRule::Channel
+                : t.mode == Mode::SpectralHistory ? EventRule::History
+                                                  : EventRule::Max;
+  events.absorption_events = t.absorption == TrackingSettings::Absorption::Collide;
+  return events;
+}
+
+// Calls f with a factory of the policy that the tracking settings select: a callable that takes
+// the path's sampler and returns a fresh policy for it. Resolved once per render; f is
+// instantiated per policy type.
+template <int N, class F>
+decltype(auto) with_tracking_policy(const TrackingSettings& t, F&& f) {
+  if (t.mode == TrackingSettings::Mode::SpectralMis)
+    return f(
+        [](PathSampler& sampler) { return HeroTracking<N>(sampler.get1d(SampleDims::kHero)); });
+  const EventPolicy events = event_policy(t);
+  // The classic baseline: Woodcock's delta tracking, with absorption events, without
+  // decomposition.
+  if (events.rule == EventRule::Channel && events.absorption_events && !t.decomposition)
+    return f([events](PathSampler&) { return PlainTracking<N, WoodcockFlight>(events); });
+  if (t.decomposition)
+    return f([events](PathSampler&) { return PlainTracking<N, DecompositionFlight>(events); });
+  return f([events](PathSampler&) { return PlainTracking<N, WeightedFlight>(events); });
+}
 
 }  // namespace nimbus

@@ -107,54 +107,77 @@ struct ShadowLookups {
 
 }  // namespace volume_detail
 
-// The next real collision over (0, t_max) of the ray (unit direction), for every mode but
-// spectral-mis. `beta`, the path throughput, is updated by the tracking weights.
-// delta: one channel per path; `channel` -1 means none is chosen yet: where the ray meets a
-// medium one is drawn uniformly and returned, and beta keeps that channel only (times N).
-// spectral-max, spectral-history: every channel along one free path; `channel` is unused.
-// `boost` is the path's majorant boost (kBoostOnRaise), grown here where a majorant failed.
-template <int N>
-MediumEvent<N> sample_collision(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray,
-                                double t_max, int inside, Spectrum<N>& beta, int& channel,
-                                double& boost, Rng& rng, Counters& counters) {
-  using Mode = TrackingSettings::Mode;
-  const TrackingSettings& ts = scene.settings.tracking;
-  const bool delta = ts.mode == Mode::Delta;
-  EventPolicy policy;
-  policy.rule = delta                              ? EventRule::Channel
-                : ts.mode == Mode::SpectralHistory ? EventRule::History
-                                                   : EventRule::Max;
-  policy.absorption_events = ts.absorption == TrackingSettings::Absorption::Collide;
-  // The classic baseline: Woodcock's delta tracking, which clamps where mu_bar does not bound.
-  const bool woodcock = delta && policy.absorption_events && !ts.decomposition;
+// The free-path estimators of the plain modes over one majorant segment [t0, t1] at rate
+// mu_bar, one type each. A render resolves its tracking settings once into one of them
+// (tracking_policies.h), and the path loop is instantiated per type: no segment asks which.
+// `events` is the collision rule and whether absorption is an event
+// (tracking/weighted_collision.h).
 
+// Woodcock's delta tracking (rule Channel with absorption events, no decomposition): the classic
+// baseline, which clamps where mu_bar does not bound.
+struct WoodcockFlight {
+  template <int N>
+  static Collision track(volume_detail::RayLookup<N>& lookup, const MajorantSegment<N>& seg,
+                         double mu_bar, const EventPolicy& events, Spectrum<N>& beta,
+                         Spectrum<N>& emitted, Rng& rng, TrackingCounters& counters) {
+    const Collision c =
+        delta_tracking<N>(lookup, seg.t0, seg.t1, mu_bar, events.channel, rng, counters);
+    if (c.event == CollisionEvent::Absorb)
+      emitted = beta * volume_detail::as_sample(lookup.last).L_e;
+    return c;
+  }
+};
+
+// Decomposition tracking: the minorant's part sampled analytically, the rest by weighted
+// tentative collisions (docs/media.md).
+struct DecompositionFlight {
+  template <int N>
+  static Collision track(volume_detail::RayLookup<N>& lookup, const MajorantSegment<N>& seg,
+                         double mu_bar, const EventPolicy& events, Spectrum<N>& beta,
+                         Spectrum<N>& emitted, Rng& rng, TrackingCounters& counters) {
+    return decomposition_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_c.min(), mu_bar, events, beta,
+                                     emitted, rng, counters);
+  }
+};
+
+// Spectral tracking: one free path for every channel, weighted collisions (eq. 6-13).
+struct WeightedFlight {
+  template <int N>
+  static Collision track(volume_detail::RayLookup<N>& lookup, const MajorantSegment<N>& seg,
+                         double mu_bar, const EventPolicy& events, Spectrum<N>& beta,
+                         Spectrum<N>& emitted, Rng& rng, TrackingCounters& counters) {
+    return spectral_tracking<N>(lookup, seg.t0, seg.t1, mu_bar, events, beta, emitted, rng,
+                                counters);
+  }
+};
+
+// The next real collision over (0, t_max) of the ray (unit direction) by the estimator Flight,
+// for every mode but spectral-mis. `beta`, the path throughput, is updated by the tracking
+// weights. Rule Channel (delta tracking): one channel per path; `events.channel` -1 means none is
+// chosen yet: where the ray meets a medium one is drawn uniformly, and beta keeps that channel
+// only (times N). Rules Max and History: every channel along one free path. `boost` is the
+// path's majorant boost (kBoostOnRaise), grown here where a majorant failed.
+template <int N, class Flight>
+MediumEvent<N> sample_collision(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray,
+                                double t_max, int inside, EventPolicy& events, Spectrum<N>& beta,
+                                double& boost, Rng& rng, Counters& counters) {
+  const bool one_channel = events.rule == EventRule::Channel;
   volume_detail::RayLookup<N> lookup{scene, ps, ray, inside, {}};
   Spectrum<N> emitted(0.0);
   MediumEvent<N> ev;
   walk_majorant_segments(scene, ps.ch, ray, 0, t_max, inside, [&](const MajorantSegment<N>& seg) {
     ++counters.majorant_segments;
-    // Delta tracking picks its channel where the path first meets a medium and reweights.
-    if (delta && channel < 0) {
-      channel = std::min(N - 1, static_cast<int>(rng.uniform() * N));
-      const double b = beta[channel];
+    // The Channel rule picks its channel where the path first meets a medium and reweights.
+    if (one_channel && events.channel < 0) {
+      events.channel = std::min(N - 1, static_cast<int>(rng.uniform() * N));
+      const double b = beta[events.channel];
       beta = Spectrum<N>(0.0);
-      beta[channel] = N * b;
+      beta[events.channel] = N * b;
     }
-    policy.channel = std::max(channel, 0);
-    const double mu_bar = boost * (delta ? seg.mu_bar[channel] : seg.mu_bar.max());
+    const double mu_bar = boost * (one_channel ? seg.mu_bar[events.channel] : seg.mu_bar.max());
     const uint64_t raised = counters.tracking.raised;
-    Collision c;
-    if (woodcock) {
-      c = delta_tracking<N>(lookup, seg.t0, seg.t1, mu_bar, channel, rng, counters.tracking);
-      if (c.event == CollisionEvent::Absorb)
-        emitted = beta * volume_detail::as_sample(lookup.last).L_e;
-    } else if (ts.decomposition) {
-      c = decomposition_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_c.min(), mu_bar, policy, beta,
-                                    emitted, rng, counters.tracking);
-    } else {
-      c = spectral_tracking<N>(lookup, seg.t0, seg.t1, mu_bar, policy, beta, emitted, rng,
-                               counters.tracking);
-    }
+    const Collision c = Flight::template track<N>(lookup, seg, mu_bar, events, beta, emitted, rng,
+                                                  counters.tracking);
     if (counters.tracking.raised != raised) boost *= kBoostOnRaise;
     if (c.event == CollisionEvent::Escape) return true;
     ev = volume_detail::real_event(c, lookup.last, counters);
@@ -221,24 +244,31 @@ Spectrum<N> transmittance(const Scene& scene, const PathSpectra<N>& ps, const Ra
     return ray_marching_transmittance<N>(lookup, std::span<const MarchSegment<N>>(segs), channel,
                                          rng, counters.tracking, &weight);
   }
-  const bool residual = estimator == Estimator::ResidualRatio;
   Spectrum<N> T(channel < 0 ? 1.0 : 0.0);
   if (channel >= 0) T[channel] = 1;
   // The largest value over the tracked channels.
   auto tracked_max = [&](const Spectrum<N>& x) { return channel < 0 ? x.max() : x[channel]; };
-  walk_majorant_segments(scene, ps.ch, ray, 0, t_max, inside, [&](const MajorantSegment<N>& seg) {
-    ++counters.majorant_segments;
-    if (residual) {
+  // Each segment updates T by `track`, until T is 0.
+  auto walk = [&](auto&& track) {
+    walk_majorant_segments(scene, ps.ch, ray, 0, t_max, inside, [&](const MajorantSegment<N>& seg) {
+      ++counters.majorant_segments;
+      T = track(seg);
+      return !T.is_black();
+    });
+  };
+  if (estimator == Estimator::ResidualRatio) {
+    walk([&](const MajorantSegment<N>& seg) {
       // The residual's rate must bound |mu_t − mu_c|; a scaled majorant may fall below mu_c.
       const Spectrum<N> gap = abs(seg.mu_bar * boost - seg.mu_c);
-      T = residual_ratio_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_c, tracked_max(gap), rng,
-                                     counters.tracking, T, &weight);
-    } else {
-      T = ratio_tracking<N>(lookup, seg.t0, seg.t1, boost * tracked_max(seg.mu_bar), rng,
-                            counters.tracking, T, &weight);
-    }
-    return !T.is_black();
-  });
+      return residual_ratio_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_c, tracked_max(gap), rng,
+                                        counters.tracking, T, &weight);
+    });
+  } else {
+    walk([&](const MajorantSegment<N>& seg) {
+      return ratio_tracking<N>(lookup, seg.t0, seg.t1, boost * tracked_max(seg.mu_bar), rng,
+                               counters.tracking, T, &weight);
+    });
+  }
   return T;
 }
 
