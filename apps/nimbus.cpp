@@ -34,9 +34,8 @@
 #include "nimbus/job/fingerprint.h"
 #include "nimbus/job/render_job.h"
 #include "nimbus/render/memory_estimate.h"
-#include "nimbus/render/path_spectra.h"
 #include "nimbus/render/renderer.h"
-#include "nimbus/render/stats.h"
+#include "nimbus/render/settings.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
 
@@ -492,8 +491,8 @@ int run_export_vdb(const ExportArgs& args) {
     }
     object = vdb_export_object(desc, args.object);
     // The export needs the objects' functions and media, not the renderer's majorants.
-    desc.integrator.tracking.octree_depth = 0;
-    desc.integrator.tracking.majorant_source = TrackingSettings::MajorantSource::Bound;
+    desc.settings.tracking.octree_depth = 0;
+    desc.settings.tracking.majorant_source = TrackingSettings::MajorantSource::Bound;
     scene = compile_scene(desc);
   } catch (const SceneError& e) {
     std::fprintf(stderr, "%s\n", e.what());
@@ -539,6 +538,20 @@ int run_export_vdb(const ExportArgs& args) {
                  result.max_density,
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
                  args.output.c_str());
+  return 0;
+}
+
+// `nimbus settings`: every render setting (render/settings.h), or one section's Markdown table.
+int list_settings(const std::string& markdown_section) {
+  using namespace nimbus;
+  if (!markdown_section.empty()) {
+    std::fputs(settings_markdown(markdown_section).c_str(), stdout);
+    return 0;
+  }
+  const RenderSettings defaults;
+  for (const Setting& s : render_settings())
+    std::printf("%-28s %-18s %s\n", std::string(s.key).c_str(), s.get(defaults).dump().c_str(),
+                std::string(s.doc).c_str());
   return 0;
 }
 
@@ -657,6 +670,15 @@ int run_command(int argc, char** argv, const Cluster& cluster) {
       ->capture_default_str();
   experiment->add_flag("--no-plot", exp.no_plot, "Write the CSV files only");
 
+  std::string markdown_section;
+  CLI::App* settings = app.add_subcommand(
+      "settings", "List the render settings of the scene format: key, type, default, meaning");
+  settings
+      ->add_option("--markdown", markdown_section,
+                   "Print the Markdown table of one section (film, integrator, spectrum), as "
+                   "docs/scene-format.md holds it")
+      ->check(CLI::IsMember({"film", "integrator", "spectrum"}));
+
   ExportArgs exp_vdb;
   CLI::App* export_vdb = app.add_subcommand(
       "export-vdb", "Write an object's medium as an OpenVDB fog volume (docs/cli.md)");
@@ -688,6 +710,7 @@ int run_command(int argc, char** argv, const Cluster& cluster) {
       return kExitBadInput;
     }
     if (experiment->parsed()) return run_experiment(exp);
+    if (settings->parsed()) return list_settings(markdown_section);
     catch_stop_signals();
     if (export_vdb->parsed()) return run_export_vdb(exp_vdb);
     return run_render(args, cluster);

@@ -40,8 +40,8 @@ Scene sized_scene(const std::string& path, std::vector<std::string> overrides, i
   overrides.push_back("integrator.seed=" + std::to_string(seed));
   overrides.push_back("integrator.sampler=\"" + sampler + "\"");
   SceneDesc desc = load_scene_file(path, overrides);
-  desc.film.height = std::max(1, desc.film.height * width / desc.film.width);
-  desc.film.width = width;
+  desc.settings.height = std::max(1, desc.settings.height * width / desc.settings.width);
+  desc.settings.width = width;
   return compile_scene(desc);
 }
 

@@ -74,9 +74,9 @@ int main(int argc, char** argv) {
       overrides.push_back("integrator.spp=" + std::to_string(spp));
       const SceneDesc desc = load_scene_file(scene_path, overrides);
       SceneDesc sized = desc;
-      sized.film.height = std::max(1, desc.film.height * width / desc.film.width);
-      sized.film.width = width;
-      tracking = name_of(kTrackingModeNames, desc.integrator.tracking.mode);
+      sized.settings.height = std::max(1, desc.settings.height * width / desc.settings.width);
+      sized.settings.width = width;
+      tracking = name_of(kTrackingModeNames, desc.settings.tracking.mode);
       const Scene scene = compile_scene(sized);
       const RenderResult r = render(scene, RenderOptions{1, {}, {}, {}});
       const double samples = double(scene.settings.width) * scene.settings.height * spp;

@@ -19,6 +19,7 @@ set(NIMBUS_PUBLIC_HEADERS
     math/box.h
     math/interval.h
     math/mat4.h
+    math/range.h
     math/ray.h
     math/vec3.h
     media/build_monitor.h

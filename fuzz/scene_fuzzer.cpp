@@ -17,11 +17,11 @@ constexpr std::size_t kMaxFuzzQuadrics = 1000;
 // Keeps one input's work small: what is fuzzed is the loader and the code paths, not the cost of
 // large images, deep paths or fine octrees (each of which the CLI bounds or estimates).
 void make_small(nimbus::SceneDesc& desc) {
-  desc.film.width = std::min(desc.film.width, 6);
-  desc.film.height = std::min(desc.film.height, 4);
-  desc.integrator.spp = 1;
-  desc.integrator.max_depth = std::min(desc.integrator.max_depth, 6);
-  nimbus::TrackingSettings& t = desc.integrator.tracking;
+  desc.settings.width = std::min(desc.settings.width, 6);
+  desc.settings.height = std::min(desc.settings.height, 4);
+  desc.settings.spp = 1;
+  desc.settings.max_depth = std::min(desc.settings.max_depth, 6);
+  nimbus::TrackingSettings& t = desc.settings.tracking;
   t.octree_depth = std::min(t.octree_depth, 3);
   t.majorant_samples = std::min(t.majorant_samples, 16);
 }

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "nimbus/render/settings.h"
 #include "nimbus/render/wavelength_counts.h"
 #include "support/process.h"
 
@@ -214,8 +215,8 @@ TEST_F(Cli, RendersDefaultOutputsAndStats) {
   EXPECT_TRUE(fs::exists(dir_ / "scene.png"));
   std::ifstream f(dir_ / "stats.json");
   const nlohmann::json s = nlohmann::json::parse(f);
-  EXPECT_EQ(s["width"], 8);
-  EXPECT_EQ(s["spp"], 3);
+  EXPECT_EQ(s["settings"]["film"]["width"], 8);
+  EXPECT_EQ(s["settings"]["integrator"]["spp"], 3);
   EXPECT_EQ(s["threads"], 2);
   EXPECT_EQ(s["counters"]["paths"], 8 * 12 * 3);
   EXPECT_GT(s["samples_per_second"].get<double>(), 0);
@@ -234,11 +235,19 @@ TEST_F(Cli, RendersDefaultOutputsAndStats) {
   EXPECT_GT(s["octree"]["bytes"].get<long>(), 0);
   EXPECT_GE(s["octree"]["build_seconds"].get<double>(), 0);
   EXPECT_GE(s["octree"]["depth"].get<int>(), 0);
-  EXPECT_EQ(s["spectrum"]["mode"], "rgb");
-  EXPECT_EQ(s["spectrum"]["channels"], 3);
-  EXPECT_EQ(s["sampler"], "zsobol");
-  EXPECT_EQ(s["tracking"]["mode"], "spectral-mis");
-  EXPECT_EQ(s["tracking"]["absorption"], "weight");
+  EXPECT_EQ(s["settings"]["spectrum"]["mode"], "rgb");
+  EXPECT_EQ(s["channels"], 3);
+  EXPECT_EQ(s["settings"]["integrator"]["sampler"], "zsobol");
+  EXPECT_EQ(s["settings"]["integrator"]["tracking"], "spectral-mis");
+  EXPECT_EQ(s["settings"]["integrator"]["absorption"], "weight");
+  // Every declared setting, by its scene-file key (render/settings.h).
+  for (const nimbus::Setting& setting : nimbus::render_settings()) {
+    nlohmann::json at = s["settings"];
+    std::string key(setting.key);
+    for (size_t dot; (dot = key.find('.')) != std::string::npos; key = key.substr(dot + 1))
+      at = at[key.substr(0, dot)];
+    EXPECT_TRUE(at.contains(key)) << setting.key;
+  }
   EXPECT_EQ(s["counters"]["rejected_samples"], 0);
   EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
 }
@@ -276,8 +285,8 @@ TEST_F(Cli, RendersInSpectralModeFromTheCommandLine) {
   EXPECT_TRUE(fs::exists(dir_ / "s.exr"));
   std::ifstream f(dir_ / "stats.json");
   const nlohmann::json s = nlohmann::json::parse(f);
-  EXPECT_EQ(s["spectrum"]["mode"], "spectral");
-  EXPECT_EQ(s["spectrum"]["channels"], n_built);
+  EXPECT_EQ(s["settings"]["spectrum"]["mode"], "spectral");
+  EXPECT_EQ(s["channels"], n_built);
   for (int c = 0; c < 3; ++c) EXPECT_GT(s["image_mean"][c].get<double>(), 0);
   // A wavelength count this build does not render is a scene error: exit 2, one line, no output.
   for (const char* n : {"6", "32"}) {

@@ -63,7 +63,7 @@ TEST_F(Job, RendersTheBitsOfRenderWithRisingProgress) {
   ASSERT_FALSE(fractions.empty());
   EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
   EXPECT_DOUBLE_EQ(fractions.back(), 1.0);
-  EXPECT_EQ(job.stats(r)["spp"], 6);
+  EXPECT_EQ(job.stats(r)["settings"]["integrator"]["spp"], 6);
   EXPECT_EQ(job.summary(r).rfind("20x12, 6 spp in ", 0), 0u) << job.summary(r);
 }
 

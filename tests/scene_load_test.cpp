@@ -481,15 +481,15 @@ TEST(SceneLoad, DenseGrayMediaCompileAndDenseChromaticOnesAreRefused) {
 TEST(SceneLoad, ExampleLoads) {
   const SceneDesc s = load(documented_example());
   EXPECT_EQ(s.source, "scene.json");
-  EXPECT_EQ(s.film.width, 640);
-  EXPECT_EQ(s.film.height, 480);
+  EXPECT_EQ(s.settings.width, 640);
+  EXPECT_EQ(s.settings.height, 480);
   EXPECT_EQ(s.camera.type, CameraDesc::Type::Perspective);
   EXPECT_EQ(s.camera.from, (Vec3{0, 1, 6}));
   EXPECT_EQ(s.camera.fov, 35);
-  EXPECT_EQ(s.integrator.spp, 64);
-  EXPECT_EQ(s.integrator.sampler, RenderSettings::Sampler::ZSobol);
-  EXPECT_EQ(s.integrator.light_sampling, RenderSettings::LightSampling::One);
-  EXPECT_EQ(s.integrator.tracking.mode, TrackingSettings::Mode::SpectralMis);
+  EXPECT_EQ(s.settings.spp, 64);
+  EXPECT_EQ(s.settings.sampler, RenderSettings::Sampler::ZSobol);
+  EXPECT_EQ(s.settings.light_sampling, RenderSettings::LightSampling::One);
+  EXPECT_EQ(s.settings.tracking.mode, TrackingSettings::Mode::SpectralMis);
 
   ASSERT_EQ(s.lights.size(), 4u);
   EXPECT_EQ(s.lights[0].type, LightDesc::Type::Environment);
@@ -545,8 +545,8 @@ TEST(SceneLoad, SpectralModeAndSpectralColours) {
                {"type": "point", "position": [0, 1, 0], "intensity": [1, 0.5, 0.25]}],
     "media": {"jade": {"sigma_s": {"spectrum": [[400, 1], [550, 4], [700, 2]]},
                        "sigma_a": 0.1}})"));
-  EXPECT_EQ(s.spectrum.mode, SpectralSettings::Mode::Spectral);
-  EXPECT_EQ(s.spectrum.wavelengths, 4);  // not the default, 8
+  EXPECT_EQ(s.settings.spectral.mode, SpectralSettings::Mode::Spectral);
+  EXPECT_EQ(s.settings.spectral.wavelengths, 4);  // not the default, 8
   // A blackbody keeps its curve; rgb mode gets its projection, of luminance `scale`.
   ASSERT_TRUE(s.lights[0].radiance.curve.has_value());
   EXPECT_EQ(s.lights[0].radiance.curve->type, SpectralCurve::Type::Blackbody);
@@ -562,7 +562,7 @@ TEST(SceneLoad, SpectralModeAndSpectralColours) {
   EXPECT_GT(sigma_s.rgb[1], sigma_s.rgb[0]);
   EXPECT_GT(sigma_s.rgb[1], sigma_s.rgb[2]);
   for (int c = 0; c < 3; ++c) EXPECT_TRUE(sigma_s.rgb[c] >= 0.5 && sigma_s.rgb[c] <= 4.5) << c;
-  EXPECT_EQ(load(with_camera("")).spectrum.mode, SpectralSettings::Mode::Rgb);
+  EXPECT_EQ(load(with_camera("")).settings.spectral.mode, SpectralSettings::Mode::Rgb);
 }
 
 TEST(SceneLoad, NamedShapesAreBuiltOnceAndShared) {
@@ -592,21 +592,21 @@ TEST(SceneLoad, DefaultsApplyWhereKeysAreOptional) {
       "media": {"m": {}},
       "objects": [{"shape": {"type": "sphere", "radius": 1}},
                   {"shape": {"type": "sphere", "radius": 1}, "medium": "m"}])"));
-  EXPECT_EQ(s.film.width, 640);
-  EXPECT_EQ(s.film.height, 480);
+  EXPECT_EQ(s.settings.width, 640);
+  EXPECT_EQ(s.settings.height, 480);
   EXPECT_EQ(s.camera.type, CameraDesc::Type::Perspective);
   EXPECT_EQ(s.camera.up, (Vec3{0, 1, 0}));
   EXPECT_EQ(s.camera.fov, 40);
-  EXPECT_EQ(s.integrator.spp, 16);
-  EXPECT_EQ(s.integrator.seed, 0u);
-  EXPECT_EQ(s.integrator.max_depth, 1000);
-  EXPECT_EQ(s.integrator.tracking.absorption, TrackingSettings::Absorption::Weight);
-  EXPECT_FALSE(s.integrator.tracking.decomposition);
-  EXPECT_EQ(s.integrator.tracking.transmittance, TrackingSettings::Transmittance::ResidualRatio);
-  EXPECT_EQ(s.integrator.tracking.majorant_source, TrackingSettings::MajorantSource::Bound);
-  EXPECT_EQ(s.integrator.tracking.majorant_samples, 4096);
-  EXPECT_EQ(s.integrator.tracking.majorant_scale, 1.0);
-  EXPECT_EQ(s.integrator.tracking.octree_depth, 4);
+  EXPECT_EQ(s.settings.spp, 16);
+  EXPECT_EQ(s.settings.seed, 0u);
+  EXPECT_EQ(s.settings.max_depth, 1000);
+  EXPECT_EQ(s.settings.tracking.absorption, TrackingSettings::Absorption::Weight);
+  EXPECT_FALSE(s.settings.tracking.decomposition);
+  EXPECT_EQ(s.settings.tracking.transmittance, TrackingSettings::Transmittance::ResidualRatio);
+  EXPECT_EQ(s.settings.tracking.majorant_source, TrackingSettings::MajorantSource::Bound);
+  EXPECT_EQ(s.settings.tracking.majorant_samples, 4096);
+  EXPECT_EQ(s.settings.tracking.majorant_scale, 1.0);
+  EXPECT_EQ(s.settings.tracking.octree_depth, 4);
   EXPECT_TRUE(s.lights.empty());
   ASSERT_EQ(s.media.size(), 1u);
   EXPECT_TRUE(s.media[0].sigma_s.rgb.is_black());
@@ -686,16 +686,16 @@ TEST(SceneLoad, OverridesReplaceAndCreateValues) {
             "lights.0.radiance=[0.1, 0.2, 0.3]", R"(integrator.tracking="spectral-mis")",
             "integrator.octree={\"depth\": 3}", R"(integrator.sampler="independent")",
             R"(integrator.light_sampling="all")"});
-  EXPECT_EQ(s.integrator.spp, 256);
-  EXPECT_EQ(s.integrator.sampler, RenderSettings::Sampler::Independent);
-  EXPECT_EQ(s.integrator.light_sampling, RenderSettings::LightSampling::All);
+  EXPECT_EQ(s.settings.spp, 256);
+  EXPECT_EQ(s.settings.sampler, RenderSettings::Sampler::Independent);
+  EXPECT_EQ(s.settings.light_sampling, RenderSettings::LightSampling::All);
   EXPECT_EQ(s.camera.from, (Vec3{1, 2, 3}));
   EXPECT_EQ(s.camera.type, CameraDesc::Type::Orthographic);
-  EXPECT_EQ(s.integrator.tracking.majorant_scale, 1.5);
-  EXPECT_EQ(s.film.width, 200);  // the last override wins
+  EXPECT_EQ(s.settings.tracking.majorant_scale, 1.5);
+  EXPECT_EQ(s.settings.width, 200);  // the last override wins
   EXPECT_EQ(s.lights[0].radiance.rgb, Rgb({0.1, 0.2, 0.3}));
-  EXPECT_EQ(s.integrator.tracking.mode, TrackingSettings::Mode::SpectralMis);
-  EXPECT_EQ(s.integrator.tracking.octree_depth, 3);
+  EXPECT_EQ(s.settings.tracking.mode, TrackingSettings::Mode::SpectralMis);
+  EXPECT_EQ(s.settings.tracking.octree_depth, 3);
 }
 
 // Issue 16: inline unions nested 5 000 deep and chains of 30 000 named aliases crashed the
@@ -758,7 +758,7 @@ TEST(SceneLoad, NumbersOutOfRangeAndDuplicateKeysInSetAreNamed) {
   EXPECT_EQ(load_error(with_camera(""), {"integrator.seed=18446744073709551616"}),
             "--set integrator.seed=18446744073709551616: /integrator/seed: must be <= "
             "18446744073709551615");
-  EXPECT_EQ(load(with_camera(""), {"integrator.seed=18446744073709551615"}).integrator.seed,
+  EXPECT_EQ(load(with_camera(""), {"integrator.seed=18446744073709551615"}).settings.seed,
             18446744073709551615ull);
 }
 
@@ -789,7 +789,7 @@ TEST(SceneLoad, DeeplyNestedShapesAreAnErrorNotACrash) {
 
 TEST(SceneLoad, OverrideCreatesMissingSections) {
   const SceneDesc s = load(with_camera(""), {"integrator.majorant.source=sample"});
-  EXPECT_EQ(s.integrator.tracking.majorant_source, TrackingSettings::MajorantSource::Sample);
+  EXPECT_EQ(s.settings.tracking.majorant_source, TrackingSettings::MajorantSource::Sample);
 }
 
 TEST(SceneLoad, OverrideReturnsTheEscapedPointerOfWhatItOwns) {
@@ -836,7 +836,7 @@ TEST_F(SceneFileTest, FileLoadsWithComments) {
   })");
   const SceneDesc s = load_scene_file(path, {"film.height=10"});
   EXPECT_EQ(s.source, path);
-  EXPECT_EQ(s.film.height, 10);
+  EXPECT_EQ(s.settings.height, 10);
 }
 
 TEST_F(SceneFileTest, SyntaxErrorGivesLineAndColumn) {

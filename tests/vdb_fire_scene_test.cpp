@@ -85,9 +85,9 @@ TEST(VdbFireScene, TheCommittedGridsAreTheGeneratorsAndTheSceneRendersFire) {
   }
 
   SceneDesc desc = load_scene_file(kScenes + "vdb_fire.json");
-  desc.film.width = 24;
-  desc.film.height = 32;
-  desc.integrator.spp = 16;
+  desc.settings.width = 24;
+  desc.settings.height = 32;
+  desc.settings.spp = 16;
   RenderOptions options;
   options.threads = 2;
   const RenderResult r = render(compile_scene(desc), options);

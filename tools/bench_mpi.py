@@ -40,7 +40,8 @@ for r in range(rounds):
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
         cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
         stats = json.load(open(f"{out}/s.json"))
-        samples = stats["width"] * stats["height"] * stats["spp"]
+        film, spp = stats["settings"]["film"], stats["settings"]["integrator"]["spp"]
+        samples = film["width"] * film["height"] * spp
         results[name].append((cpu / samples * 1e6, wall, stats.get("mpi")))
 for name, runs in results.items():
     cpu = statistics.median(x[0] for x in runs)

@@ -69,9 +69,9 @@ void RenderJob::set_scene(Scene scene, const nlohmann::json& identity) {
 }
 
 void RenderJob::check() const {
-  const int width = compiled_ ? scene_.settings.width : desc_.film.width;
-  const int height = compiled_ ? scene_.settings.height : desc_.film.height;
-  const int spp = compiled_ ? scene_.settings.spp : desc_.integrator.spp;
+  const int width = compiled_ ? scene_.settings.width : desc_.settings.width;
+  const int height = compiled_ ? scene_.settings.height : desc_.settings.height;
+  const int spp = compiled_ ? scene_.settings.spp : desc_.settings.spp;
   if (resumed_) {
     const std::string& file = options_.resume;
     if (const std::string d = fingerprint_difference(resumed_->fingerprint, fingerprint_);
@@ -225,10 +225,10 @@ std::vector<NamedFile> RenderJob::files_written() const {
 void check_render_memory(const SceneDesc& desc, int threads, std::optional<uint64_t> max_memory) {
   int octrees = 1;  // the field's, and one per solid holding a medium (render/scene.h)
   for (const ObjectDesc& o : desc.objects) octrees += has_own_octree(o.medium, o.surface.type);
-  const int bins = desc.spectrum.mode == SpectralSettings::Mode::Spectral ? kSpectralBins : 3;
+  const int bins = desc.settings.spectral.mode == SpectralSettings::Mode::Spectral ? kSpectralBins : 3;
   const int workers = threads > 0 ? threads : int(std::thread::hardware_concurrency());
   const MemoryEstimate need =
-      estimate_render_memory(desc.film.width, desc.film.height, octrees, bins, workers);
+      estimate_render_memory(desc.settings.width, desc.settings.height, octrees, bins, workers);
   const uint64_t limit = max_memory ? *max_memory : available_memory();
   if (limit > 0 && need.total() > double(limit))
     throw JobError(fmt::format(

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "nimbus/render/setting_names.h"
+#include "nimbus/render/settings.h"
 
 namespace nimbus {
 
@@ -13,23 +13,12 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
   const MeanEstimate m = image_mean(result.film);
   nlohmann::json j;
   j["scene"] = scene_path;
-  j["width"] = scene.settings.width;
-  j["height"] = scene.settings.height;
-  j["spp"] = scene.settings.spp;
-  j["seed"] = scene.settings.seed;
   j["threads"] = result.threads;
-  const bool spectral = scene.settings.spectral.mode == SpectralSettings::Mode::Spectral;
-  j["spectrum"] = {{"mode", name_of(kSpectrumModeNames, scene.settings.spectral.mode)},
-                   {"channels", spectral ? scene.settings.spectral.wavelengths : 3}};
-  j["sampler"] = name_of(kSamplerNames, scene.settings.sampler);
-  j["light_sampling"] = name_of(kLightSamplingNames, scene.settings.light_sampling);
-  const TrackingSettings& t = scene.settings.tracking;
-  j["tracking"] = {{"mode", name_of(kTrackingModeNames, t.mode)},
-                   {"absorption", name_of(kAbsorptionNames, t.absorption)},
-                   {"decomposition", t.decomposition},
-                   {"transmittance", name_of(kTransmittanceNames, t.transmittance)},
-                   {"majorant_source", name_of(kMajorantSourceNames, t.majorant_source)},
-                   {"majorant_scale", t.majorant_scale}};
+  // Every setting rendered with, by its scene-file key (render/settings.h).
+  j["settings"] = settings_json(scene.settings);
+  j["channels"] = scene.settings.spectral.mode == SpectralSettings::Mode::Spectral
+                      ? scene.settings.spectral.wavelengths
+                      : 3;
   j["wall_seconds"] = result.seconds;
   j["samples_per_second"] = result.seconds > 0 ? samples / result.seconds : 0.0;
   j["image_mean"] = {m.mean[0], m.mean[1], m.mean[2]};

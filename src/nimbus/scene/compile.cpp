@@ -14,7 +14,7 @@
 namespace nimbus {
 namespace {
 
-Camera compile_camera(const CameraDesc& c, const FilmDesc& film) {
+Camera compile_camera(const CameraDesc& c, const RenderSettings& film) {
   if (c.type == CameraDesc::Type::Orthographic)
     return orthographic_camera(c.from, c.to, c.up, c.width, film.width, film.height);
   return perspective_camera(c.from, c.to, c.up, c.fov, film.width, film.height);
@@ -95,16 +95,8 @@ double null_thickness_bound(const Scene& scene, size_t object) {
 
 Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor) {
   Scene scene;
-  scene.settings.width = desc.film.width;
-  scene.settings.height = desc.film.height;
-  scene.settings.spp = desc.integrator.spp;
-  scene.settings.seed = desc.integrator.seed;
-  scene.settings.max_depth = desc.integrator.max_depth;
-  scene.settings.sampler = desc.integrator.sampler;
-  scene.settings.light_sampling = desc.integrator.light_sampling;
-  scene.settings.tracking = desc.integrator.tracking;
-  scene.settings.spectral = desc.spectrum;
-  scene.camera = compile_camera(desc.camera, desc.film);
+  scene.settings = desc.settings;
+  scene.camera = compile_camera(desc.camera, desc.settings);
 
   for (const MediumDesc& md : desc.media) scene.media.push_back(compile_medium(md));
 

@@ -11,17 +11,7 @@ namespace nimbus {
 namespace {
 
 std::string describe(const Range& r) {
-  const char* open_lo = r.lo_open ? "(" : "[";
-  const char* close_hi = r.hi_open ? ")" : "]";
-  if (r.lo && r.hi) return fmt::format("must be in {}{}, {}{}", open_lo, *r.lo, *r.hi, close_hi);
-  if (r.lo) return fmt::format("must be {} {}", r.lo_open ? ">" : ">=", *r.lo);
-  return fmt::format("must be {} {}", r.hi_open ? "<" : "<=", *r.hi);
-}
-
-bool contains(const Range& r, double x) {
-  if (r.lo && (r.lo_open ? !(x > *r.lo) : !(x >= *r.lo))) return false;
-  if (r.hi && (r.hi_open ? !(x < *r.hi) : !(x <= *r.hi))) return false;
-  return true;
+  return "must be " + range_text(r);
 }
 
 // Levenshtein distance, for suggesting the key a typo was meant to be.

@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "nimbus/math/range.h"
 #include "nimbus/math/vec3.h"
 #include "nimbus/scene/input_file.h"
 #include "nimbus/spectral/spectrum.h"
@@ -49,24 +50,6 @@ struct JsonOrigin {
   // recorded.
   std::vector<InputFile>* inputs = nullptr;
 };
-
-// An allowed interval for numbers; each end may be open, closed or absent.
-struct Range {
-  std::optional<double> lo, hi;
-  bool lo_open = false, hi_open = false;
-};
-inline Range at_least(double lo) {
-  return {lo, {}, false, false};
-}
-inline Range above(double lo) {
-  return {lo, {}, true, false};
-}
-inline Range between(double lo, double hi) {
-  return {lo, hi, false, false};
-}  // [lo, hi]
-inline Range strictly_between(double lo, double hi) {
-  return {lo, hi, true, true};
-}  // (lo, hi)
 
 // One JSON value and its JSON pointer ("" for the document itself).
 class JsonValue {

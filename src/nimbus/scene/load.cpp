@@ -18,6 +18,7 @@
 #include "nimbus/media/octree.h"
 #include "nimbus/render/scene.h"
 #include "nimbus/render/setting_names.h"
+#include "nimbus/render/settings.h"
 #include "nimbus/render/wavelength_counts.h"
 #include "nimbus/scene/density_types.h"
 #include "nimbus/scene/emission_grid.h"
@@ -141,10 +142,10 @@ class Loader {
 
     SceneDesc scene;
     scene.source = root_.value().origin().source;
-    if (film) scene.film = read_film(*film);
+    if (film) read_settings(*film, "film.", scene.settings);
     scene.camera = read_camera(camera ? *camera : root_.required("camera"));
-    if (integrator) scene.integrator = read_integrator(*integrator);
-    if (spectrum) scene.spectrum = read_spectrum(*spectrum);
+    if (integrator) read_settings(*integrator, "integrator.", scene.settings);
+    if (spectrum) read_settings(*spectrum, "spectrum.", scene.settings);
     if (lights)
       for (const JsonValue& l : lights->array()) scene.lights.push_back(read_light(l));
     if (shapes) {
@@ -165,15 +166,6 @@ class Loader {
   }
 
  private:
-  static FilmDesc read_film(const JsonValue& v) {
-    JsonObject o(v);
-    FilmDesc f;
-    if (auto w = o.optional("width")) f.width = w->integer(between(1, 16384));
-    if (auto h = o.optional("height")) f.height = h->integer(between(1, 16384));
-    o.finish();
-    return f;
-  }
-
   static CameraDesc read_camera(const JsonValue& v) {
     JsonObject o(v);
     CameraDesc c;
@@ -199,53 +191,49 @@ class Loader {
     return c;
   }
 
-  static SpectrumDesc read_spectrum(const JsonValue& v) {
+  // The settings under `prefix` ("integrator.") in the section `v`, through their declarations
+  // (render/settings.h), in the order declared; a subsection ("majorant") is an object.
+  static void read_settings(const JsonValue& v, const std::string& prefix,
+                            RenderSettings& settings) {
     JsonObject o(v);
-    SpectrumDesc d;
-    if (auto x = o.optional("mode")) d.mode = choice_of(*x, "spectrum mode", kSpectrumModeNames);
-    if (auto x = o.optional("wavelengths")) {
-      d.wavelengths = x->integer();
-      if (!is_built_wavelength_count(d.wavelengths))
-        x->fail(
-            fmt::format("must be one of {} (the counts this build renders: CMake option "
-                        "NIMBUS_WAVELENGTH_COUNTS)",
-                        fmt::join(built_wavelength_counts(), ", ")));
+    std::set<std::string, std::less<>> subsections;
+    for (const Setting& s : render_settings()) {
+      if (!s.key.starts_with(prefix)) continue;
+      const std::string rest(s.key.substr(prefix.size()));
+      if (const size_t dot = rest.find('.'); dot != std::string::npos) {
+        const std::string sub = rest.substr(0, dot);
+        if (subsections.insert(sub).second)
+          if (auto x = o.optional(sub)) read_settings(*x, prefix + sub + ".", settings);
+      } else if (auto x = o.optional(rest)) {
+        read_setting(*x, s, settings);
+      }
     }
     o.finish();
-    return d;
   }
 
-  static IntegratorDesc read_integrator(const JsonValue& v) {
-    JsonObject o(v);
-    IntegratorDesc d;
-    if (auto x = o.optional("spp")) d.spp = x->integer(at_least(1));
-    if (auto x = o.optional("seed")) d.seed = x->unsigned_integer();
-    if (auto x = o.optional("max_depth")) d.max_depth = x->integer(at_least(1));
-    if (auto x = o.optional("sampler")) d.sampler = choice_of(*x, "sampler", kSamplerNames);
-    if (auto x = o.optional("light_sampling"))
-      d.light_sampling = choice_of(*x, "light_sampling", kLightSamplingNames);
-    TrackingSettings& t = d.tracking;
-    if (auto x = o.optional("tracking")) t.mode = choice_of(*x, "tracking", kTrackingModeNames);
-    if (auto x = o.optional("absorption"))
-      t.absorption = choice_of(*x, "absorption", kAbsorptionNames);
-    if (auto x = o.optional("decomposition")) t.decomposition = x->boolean();
-    if (auto x = o.optional("transmittance"))
-      t.transmittance = choice_of(*x, "transmittance", kTransmittanceNames);
-    if (auto x = o.optional("majorant")) {
-      JsonObject m(*x);
-      if (auto y = m.optional("source"))
-        t.majorant_source = choice_of(*y, "majorant source", kMajorantSourceNames);
-      if (auto y = m.optional("samples")) t.majorant_samples = y->integer(at_least(1));
-      if (auto y = m.optional("scale")) t.majorant_scale = y->number(above(0));
-      m.finish();
+  static void read_setting(const JsonValue& x, const Setting& s, RenderSettings& settings) {
+    using Kind = SettingType::Kind;
+    nlohmann::json value;
+    switch (s.type.kind) {
+      case Kind::Integer:
+        value = x.integer(s.type.range);
+        break;
+      case Kind::Unsigned:
+        value = x.unsigned_integer();
+        break;
+      case Kind::Number:
+        value = x.number(s.type.range);
+        break;
+      case Kind::Boolean:
+        value = x.boolean();
+        break;
+      case Kind::Choice:
+        value = std::string(s.type.names[x.choice(s.type.noun, s.type.names)]);
+        break;
     }
-    if (auto x = o.optional("octree")) {
-      JsonObject oc(*x);
-      if (auto y = oc.optional("depth")) t.octree_depth = y->integer(between(0, kOctreeMaxDepth));
-      oc.finish();
-    }
-    o.finish();
-    return d;
+    if (s.check)
+      if (const std::string problem = s.check(value); !problem.empty()) x.fail(problem);
+    s.set(settings, value);
   }
 
   static LightDesc read_light(const JsonValue& v) {

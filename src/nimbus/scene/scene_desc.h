@@ -20,10 +20,6 @@
 
 namespace nimbus {
 
-struct FilmDesc {
-  int width = 640, height = 480;
-};
-
 struct CameraDesc {
   enum class Type { Perspective, Orthographic };
   Type type = Type::Perspective;
@@ -31,18 +27,6 @@ struct CameraDesc {
   double fov = 40;   // vertical field of view in degrees (perspective)
   double width = 2;  // width of the view in world units (orthographic)
 };
-
-struct IntegratorDesc {
-  int spp = 16;
-  uint64_t seed = 0;
-  int max_depth = 1000;
-  RenderSettings::Sampler sampler = RenderSettings::Sampler::ZSobol;
-  RenderSettings::LightSampling light_sampling = RenderSettings::LightSampling::One;
-  TrackingSettings tracking;  // its defaults are the scene format's
-};
-
-// How colours are carried (docs/spectra.md): "rgb" or "spectral" with `wavelengths` per path.
-using SpectrumDesc = SpectralSettings;
 
 // Colour inputs are SpectralParam: RGB (a number or [r, g, b]) or a curve from the file
 // ({"spectrum": [[nm, value], ...]}, or {"blackbody": K, "scale": s} where light is emitted).
@@ -92,10 +76,10 @@ struct ObjectDesc {
 
 struct SceneDesc {
   std::string source;  // the file name (or other source) used in messages
-  FilmDesc film;
+  // The "film", "integrator" and "spectrum" sections: the render's settings themselves, read
+  // through their declarations (render/settings.h).
+  RenderSettings settings;
   CameraDesc camera;
-  IntegratorDesc integrator;
-  SpectrumDesc spectrum;
   std::vector<LightDesc> lights;
   std::vector<MediumDesc> media;
   std::vector<ObjectDesc> objects;
