@@ -492,14 +492,14 @@ TEST(SceneLoad, ExampleLoads) {
   EXPECT_EQ(s.settings.tracking.mode, TrackingSettings::Mode::SpectralMis);
 
   ASSERT_EQ(s.lights.size(), 4u);
-  EXPECT_EQ(s.lights[0].type, LightDesc::Type::Environment);
-  EXPECT_EQ(s.lights[0].radiance.rgb, Rgb({0.8, 0.9, 1.0}));
-  EXPECT_EQ(s.lights[1].type, LightDesc::Type::Directional);
+  EXPECT_EQ(s.lights[0].type, Light::Type::Environment);
+  EXPECT_EQ(s.lights[0].emission.rgb, Rgb({0.8, 0.9, 1.0}));
+  EXPECT_EQ(s.lights[1].type, Light::Type::Directional);
   EXPECT_EQ(s.lights[1].direction, (Vec3{0, -1, 0}));
-  EXPECT_EQ(s.lights[1].irradiance.rgb, Rgb(3));
-  EXPECT_EQ(s.lights[2].type, LightDesc::Type::Point);
+  EXPECT_EQ(s.lights[1].emission.rgb, Rgb(3));
+  EXPECT_EQ(s.lights[2].type, Light::Type::Point);
   EXPECT_EQ(s.lights[2].position, (Vec3{1, 4, 2}));
-  EXPECT_EQ(s.lights[3].type, LightDesc::Type::Sphere);
+  EXPECT_EQ(s.lights[3].type, Light::Type::Sphere);
   EXPECT_EQ(s.lights[3].radius, 0.5);
 
   // Media are ordered by name; objects refer to them by index.
@@ -548,12 +548,12 @@ TEST(SceneLoad, SpectralModeAndSpectralColours) {
   EXPECT_EQ(s.settings.spectral.mode, SpectralSettings::Mode::Spectral);
   EXPECT_EQ(s.settings.spectral.wavelengths, 4);  // not the default, 8
   // A blackbody keeps its curve; rgb mode gets its projection, of luminance `scale`.
-  ASSERT_TRUE(s.lights[0].radiance.curve.has_value());
-  EXPECT_EQ(s.lights[0].radiance.curve->type, SpectralCurve::Type::Blackbody);
-  EXPECT_NEAR(linear_srgb_to_xyz(s.lights[0].radiance.rgb).y, 2.0, 1e-3);
+  ASSERT_TRUE(s.lights[0].emission.curve.has_value());
+  EXPECT_EQ(s.lights[0].emission.curve->type, SpectralCurve::Type::Blackbody);
+  EXPECT_NEAR(linear_srgb_to_xyz(s.lights[0].emission.rgb).y, 2.0, 1e-3);
   // RGB inputs get their curves when the scene is compiled.
-  EXPECT_FALSE(s.lights[1].intensity.curve.has_value());
-  EXPECT_EQ(s.lights[1].intensity.rgb, Rgb({1, 0.5, 0.25}));
+  EXPECT_FALSE(s.lights[1].emission.curve.has_value());
+  EXPECT_EQ(s.lights[1].emission.rgb, Rgb({1, 0.5, 0.25}));
   const SpectralParam& sigma_s = s.media[0].sigma_s;
   ASSERT_TRUE(sigma_s.curve.has_value());
   EXPECT_DOUBLE_EQ((*sigma_s.curve)(475), 2.5);
@@ -693,7 +693,7 @@ TEST(SceneLoad, OverridesReplaceAndCreateValues) {
   EXPECT_EQ(s.camera.type, CameraDesc::Type::Orthographic);
   EXPECT_EQ(s.settings.tracking.majorant_scale, 1.5);
   EXPECT_EQ(s.settings.width, 200);  // the last override wins
-  EXPECT_EQ(s.lights[0].radiance.rgb, Rgb({0.1, 0.2, 0.3}));
+  EXPECT_EQ(s.lights[0].emission.rgb, Rgb({0.1, 0.2, 0.3}));
   EXPECT_EQ(s.settings.tracking.mode, TrackingSettings::Mode::SpectralMis);
   EXPECT_EQ(s.settings.tracking.octree_depth, 3);
 }

@@ -198,7 +198,7 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
 
     if (!hit) {
       for (size_t i = 0; i < scene.lights.size(); ++i)
-        if (scene.lights[i].type == Light::Type::Environment)
+        if (at_infinity(scene.lights[i]))
           L += policy.light_hit(ps.lights[i], scene.lights[i], prev_p, ray.d, light_sampled,
                                 light_sampling_pdf(scene, ps, int(i), prev_p));
       break;

@@ -1,8 +1,10 @@
 #include "nimbus/render/light.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "nimbus/math/constants.h"
 #include "nimbus/render/sampling.h"
 
 namespace nimbus {
@@ -33,7 +35,7 @@ std::optional<LightSample> sample_light(const Light& light, const Vec3& p, doubl
       const double cos_max = sphere_cos_max(light, d2);
       const Vec3 axis = d / std::sqrt(d2);
       const Vec3 wi = sample_uniform_cone(axis, cos_max, u1, u2);
-      const auto t = intersect_sphere_light(light, {p, wi}, 0, kInf);
+      const auto t = intersect_light(light, {p, wi}, 0, kInf);
       // The cone is tangent to the sphere; a direction at its rim can round to a miss.
       const double dist = t ? *t : std::sqrt(d2 - light.radius * light.radius);
       return LightSample{wi, dist, 1.0, 1 / (2 * kPi * (1 - cos_max)), false};
@@ -61,8 +63,36 @@ double light_pdf(const Light& light, const Vec3& p, const Vec3& w) {
   return 0;
 }
 
-std::optional<double> intersect_sphere_light(const Light& light, const Ray& ray, double t_min,
-                                             double t_max) {
+bool at_infinity(const Light& light) {
+  return light.type == Light::Type::Environment;
+}
+
+bool has_surface(const Light& light) {
+  return light.type == Light::Type::Sphere;
+}
+
+double light_fluence(const Light& light, double e, const Vec3& p) {
+  switch (light.type) {
+    case Light::Type::Environment:
+      return 4 * kPi * e;
+    case Light::Type::Directional:
+      return e;
+    case Light::Type::Point:
+      return e / std::max(dot(p - light.position, p - light.position), 1e-300);
+    case Light::Type::Sphere: {
+      const double d2 = dot(p - light.center, p - light.center), r2 = light.radius * light.radius;
+      if (d2 <= r2) return 4 * kPi * e;
+      const double sin2 = r2 / d2;
+      // 1 − cos θ_max = sin² / (1 + cos), accurate for small spheres far away.
+      return 2 * kPi * e * sin2 / (1 + std::sqrt(1 - sin2));
+    }
+  }
+  return 0;
+}
+
+std::optional<double> intersect_light(const Light& light, const Ray& ray, double t_min,
+                                      double t_max) {
+  if (light.type != Light::Type::Sphere) return std::nullopt;
   const Vec3 oc = ray.o - light.center;
   const double b = dot(oc, ray.d);
   const double c = dot(oc, oc) - light.radius * light.radius;

@@ -1,6 +1,8 @@
 #pragma once
 // Light sources: constant environment, directional (delta direction), point (delta position),
-// and spherical area lights (sampled by the cone they subtend).
+// and spherical area lights (sampled by the cone they subtend). Everything the renderer asks of
+// a light is here and in light.cpp, one switch per question; the scene file's keys of each type
+// are read by scene/light_types.cpp. A new light type is those three files.
 
 #include <optional>
 
@@ -39,8 +41,22 @@ std::optional<LightSample> sample_light(const Light& light, const Vec3& p, doubl
 // for a sphere light that p is inside of).
 double light_pdf(const Light& light, const Vec3& p, const Vec3& w);
 
-// Nearest t > t_min where the ray (unit direction) meets a sphere light's surface from outside.
-std::optional<double> intersect_sphere_light(const Light& light, const Ray& ray, double t_min,
-                                             double t_max);
+// Whether rays that leave the scene meet the light (the environment): the path loop adds its
+// radiance when a ray hits nothing.
+bool at_infinity(const Light& light);
+
+// Whether rays can hit the light's surface (a sphere): it is then in the scene's SurfaceIndex,
+// found by intersect and blocking shadow rays to other lights.
+bool has_surface(const Light& light);
+
+// Nearest t in (t_min, t_max) where the ray (unit direction) meets the light's surface from
+// outside; none for lights without one.
+std::optional<double> intersect_light(const Light& light, const Ray& ray, double t_min,
+                                      double t_max);
+
+// The light's unoccluded fluence at p, ∫ L dω over the directions it covers, for an emission of
+// `emission` (the average over a path's channels, >= 0): environment 4π L, directional E,
+// point I / d², sphere L · 2π (1 − cos θ_max) (4π L inside). Light choice weighs lights by it.
+double light_fluence(const Light& light, double emission, const Vec3& p);
 
 }  // namespace nimbus

@@ -21,26 +21,11 @@
 
 namespace nimbus {
 
-// The unoccluded fluence of `light`, whose emission at the path's channels is `emission`, at p.
+// The unoccluded fluence of `light`, whose emission at the path's channels is `emission`, at p
+// (light.h).
 template <int N>
 double light_fluence(const Light& light, const Spectrum<N>& emission, const Vec3& p) {
-  const double e = std::max(0.0, emission.average());
-  switch (light.type) {
-    case Light::Type::Environment:
-      return 4 * kPi * e;
-    case Light::Type::Directional:
-      return e;
-    case Light::Type::Point:
-      return e / std::max(dot(p - light.position, p - light.position), 1e-300);
-    case Light::Type::Sphere: {
-      const double d2 = dot(p - light.center, p - light.center), r2 = light.radius * light.radius;
-      if (d2 <= r2) return 4 * kPi * e;
-      const double sin2 = r2 / d2;
-      // 1 − cos θ_max = sin² / (1 + cos), accurate for small spheres far away.
-      return 2 * kPi * e * sin2 / (1 + std::sqrt(1 - sin2));
-    }
-  }
-  return 0;
+  return light_fluence(light, std::max(0.0, emission.average()), p);
 }
 
 // The weight with which light j is picked at p: its fluence there, but 0 for a constant
@@ -53,7 +38,7 @@ template <int N>
 double light_choice_weight(const Scene& scene, const PathSpectra<N>& ps, int j, const Vec3& p,
                            bool skip_environment) {
   const Light& light = scene.lights[j];
-  if (skip_environment && light.type == Light::Type::Environment) return 0;
+  if (skip_environment && at_infinity(light)) return 0;
   return light_fluence(light, ps.lights[j], p);
 }
 

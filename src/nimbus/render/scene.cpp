@@ -10,7 +10,7 @@ SurfaceIndex build_surface_index(const std::vector<SceneObject>& objects,
   for (size_t i = 0; i < objects.size(); ++i)
     if (objects[i].surface.type != Surface::Type::None) index.objects.push_back(int(i));
   for (size_t i = 0; i < lights.size(); ++i)
-    if (lights[i].type == Light::Type::Sphere) index.lights.push_back(int(i));
+    if (has_surface(lights[i])) index.lights.push_back(int(i));
   index.object_count = objects.size();
   index.light_count = lights.size();
   return index;
@@ -28,7 +28,7 @@ std::optional<SurfaceHit> intersect(const Scene& scene, const Ray& ray, double t
     }
   }
   for (const int i : scene.surfaces.lights) {
-    if (auto t = intersect_sphere_light(scene.lights[i], ray, 0, t_max)) {
+    if (auto t = intersect_light(scene.lights[i], ray, 0, t_max)) {
       t_max = *t;
       best = SurfaceHit{*t, -1, i};
     }
@@ -44,7 +44,7 @@ bool occluded(const Scene& scene, const Ray& ray, double t_max, int target_light
     if (first_hit(obj.tape, ray, t0, t1)) return true;
   }
   for (const int i : scene.surfaces.lights)
-    if (i != target_light && intersect_sphere_light(scene.lights[i], ray, 0, t_max)) return true;
+    if (i != target_light && intersect_light(scene.lights[i], ray, 0, t_max)) return true;
   return false;
 }
 

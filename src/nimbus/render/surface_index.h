@@ -15,7 +15,7 @@ struct SceneObject;
 
 struct SurfaceIndex {
   std::vector<int> objects;  // indices of the scene's objects with a surface
-  std::vector<int> lights;   // indices of its sphere lights
+  std::vector<int> lights;   // indices of its lights with a surface (has_surface)
   // The sizes it was built for: render_into refuses a scene changed since (finish_scene).
   size_t object_count = 0, light_count = 0;
 };

@@ -20,19 +20,6 @@ Camera compile_camera(const CameraDesc& c, const RenderSettings& film) {
   return perspective_camera(c.from, c.to, c.up, c.fov, film.width, film.height);
 }
 
-Light compile_light(const LightDesc& d) {
-  Light l;
-  l.type = d.type;
-  l.emission = d.type == LightDesc::Type::Directional ? d.irradiance
-               : d.type == LightDesc::Type::Point     ? d.intensity
-                                                      : d.radiance;
-  l.direction = d.type == LightDesc::Type::Directional ? normalize(d.direction) : d.direction;
-  l.position = d.position;
-  l.center = d.center;
-  l.radius = d.radius;
-  return l;
-}
-
 Surface compile_surface(const SurfaceDesc& d) {
   Surface s;
   s.type = d.type;
@@ -128,7 +115,7 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor) {
     scene.objects.push_back(std::move(obj));
     object_descs.push_back(&od);
   }
-  for (const LightDesc& ld : desc.lights) scene.lights.push_back(compile_light(ld));
+  scene.lights = desc.lights;
   finish_scene(scene, monitor);
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const SceneObject& obj = scene.objects[i];

@@ -20,8 +20,10 @@
 #include "nimbus/render/setting_names.h"
 #include "nimbus/render/settings.h"
 #include "nimbus/render/wavelength_counts.h"
+#include "nimbus/scene/colour_reader.h"
 #include "nimbus/scene/density_types.h"
 #include "nimbus/scene/emission_grid.h"
+#include "nimbus/scene/light_types.h"
 
 namespace nimbus {
 namespace {
@@ -33,9 +35,8 @@ constexpr double kMinDeterminant = 1e-12;
 // In the order of SurfaceDesc::Type, so that an index is the enumerator.
 const std::vector<std::string_view> kSurfaceTypes = {"none", "diffuse", "dielectric", "emissive"};
 
-// A colour input: RGB (one number or [r, g, b]) in `range`, or an object holding a sampled
-// spectrum {"spectrum": [[nm, value], ...]} (values in `range`, nm strictly increasing) or, for
-// emitted light only, a blackbody {"blackbody": kelvin, "scale": luminance}.
+}  // namespace
+
 SpectralParam read_colour(const JsonValue& v, SpectralRole role, const Range& range) {
   if (!v.json().is_object()) return SpectralParam(v.rgb(range));
   JsonObject o(v);
@@ -67,6 +68,8 @@ SpectralParam read_colour(const JsonValue& v, SpectralRole role, const Range& ra
   }
   return from_curve(piecewise_linear_spectrum(std::move(points)), role);
 }
+
+namespace {
 
 std::string string_choice(const JsonValue& v, std::string_view noun,
                           const std::vector<std::string_view>& names) {
@@ -236,32 +239,13 @@ class Loader {
     s.set(settings, value);
   }
 
-  static LightDesc read_light(const JsonValue& v) {
+  static Light read_light(const JsonValue& v) {
     JsonObject o(v);
-    LightDesc l;
     const JsonValue type = o.required("type");
-    // In the order of LightDesc::Type, so that an index is the enumerator.
-    const size_t kind =
-        type.choice("light type", {"environment", "directional", "point", "sphere"});
-    l.type = static_cast<LightDesc::Type>(kind);
-    switch (l.type) {
-      case LightDesc::Type::Environment:
-        l.radiance = read_colour(o.required("radiance"), SpectralRole::Illuminant, at_least(0));
-        break;
-      case LightDesc::Type::Directional:
-        l.direction = normalize(o.required("direction").direction());
-        l.irradiance = read_colour(o.required("irradiance"), SpectralRole::Illuminant, at_least(0));
-        break;
-      case LightDesc::Type::Point:
-        l.position = o.required("position").vec3();
-        l.intensity = read_colour(o.required("intensity"), SpectralRole::Illuminant, at_least(0));
-        break;
-      case LightDesc::Type::Sphere:
-        l.center = o.required("center").vec3();
-        l.radius = o.required("radius").number(above(0));
-        l.radiance = read_colour(o.required("radiance"), SpectralRole::Illuminant, at_least(0));
-        break;
-    }
+    std::vector<std::string_view> names;
+    for (const LightType& t : light_types()) names.push_back(t.name);
+    Light l;
+    light_types()[type.choice("light type", names)].read(o, l);
     o.finish(fmt::format("for light type \"{}\"", type.string()));
     return l;
   }

@@ -30,17 +30,7 @@ struct CameraDesc {
 
 // Colour inputs are SpectralParam: RGB (a number or [r, g, b]) or a curve from the file
 // ({"spectrum": [[nm, value], ...]}, or {"blackbody": K, "scale": s} where light is emitted).
-struct LightDesc {
-  using Type = Light::Type;
-  Type type = Type::Environment;
-  SpectralParam radiance;    // environment, sphere
-  SpectralParam irradiance;  // directional
-  SpectralParam intensity;   // point
-  Vec3 direction;            // directional: the direction the light travels, unit length
-  Vec3 position;             // point
-  Vec3 center;               // sphere
-  double radius = 0;
-};
+// Lights are the run-time Light itself (render/light.h), read by scene/light_types.cpp.
 
 struct PhaseDesc {
   enum class Type { Isotropic, HenyeyGreenstein };
@@ -80,7 +70,7 @@ struct SceneDesc {
   // through their declarations (render/settings.h).
   RenderSettings settings;
   CameraDesc camera;
-  std::vector<LightDesc> lights;
+  std::vector<Light> lights;
   std::vector<MediumDesc> media;
   std::vector<ObjectDesc> objects;
   // Every file the description made the loader read, in the order read (not the scene file
