@@ -110,12 +110,11 @@ struct Outcome {
   std::string message;
 };
 
-// The files a run reads: the scene file and every file its description made the loader read.
+// The files a run reads: the scene file and every file compiling it read.
 std::vector<nimbus::NamedFile> scene_inputs(const std::string& scene,
-                                            const nimbus::SceneDesc& desc) {
+                                            const std::vector<nimbus::InputFile>& read) {
   std::vector<nimbus::NamedFile> inputs = {{"the scene file", scene}};
-  for (const nimbus::InputFile& f : desc.inputs)
-    inputs.push_back({"the file of " + f.pointer, f.path});
+  for (const nimbus::InputFile& f : read) inputs.push_back({"the file of " + f.pointer, f.path});
   return inputs;
 }
 
@@ -325,7 +324,6 @@ int run_render(const RenderArgs& args, const Cluster& cluster) {
       step = {kExitBadInput, fmt::format("nimbus: {}", e.what())};
     }
   if (step.code == 0) step = attempt([&] { job.load(args.scene, spp); });
-  if (lead && step.code == 0) step = check_outputs(args, job, outputs);
   if (lead && step.code == 0) step = attempt([&] { job.check(); });
   if (const int code = agree(cluster, step); code != 0) return code;
 
@@ -351,7 +349,9 @@ int run_render(const RenderArgs& args, const Cluster& cluster) {
                                       "nimbus?",
                                       mine, first)};
   else if (lead)
-    step = attempt([&] { job.check_majorants(); });
+    step = attempt([&] { job.check_compiled(); });
+  // The files the scene read are known once it is compiled (VDB grids).
+  if (lead && step.code == 0) step = check_outputs(args, job, outputs);
   if (const int code = agree(cluster, step); code != 0) return code;
 
   ClusterChannel channel(cluster);
@@ -483,17 +483,18 @@ int run_export_vdb(const ExportArgs& args) {
   int object = -1;
   try {
     SceneDesc desc = load_scene_file(args.scene, args.sets);
-    try {
-      check_outputs_distinct({{"-o", args.output}}, scene_inputs(args.scene, desc));
-    } catch (const std::runtime_error& e) {
-      std::fprintf(stderr, "nimbus: %s\n", e.what());
-      return kExitBadInput;
-    }
     object = vdb_export_object(desc, args.object);
     // The export needs the objects' functions and media, not the renderer's majorants.
     desc.settings.tracking.octree_depth = 0;
     desc.settings.tracking.majorant_source = TrackingSettings::MajorantSource::Bound;
-    scene = compile_scene(desc);
+    std::vector<InputFile> read;
+    scene = compile_scene(desc, {}, &read);
+    try {
+      check_outputs_distinct({{"-o", args.output}}, scene_inputs(args.scene, read));
+    } catch (const std::runtime_error& e) {
+      std::fprintf(stderr, "nimbus: %s\n", e.what());
+      return kExitBadInput;
+    }
   } catch (const SceneError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return kExitBadInput;

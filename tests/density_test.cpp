@@ -33,7 +33,8 @@ TEST(Density, EveryTypesRangeHoldsItsValues) {
     const nlohmann::json params =
         required.contains(name) ? required[name] : nlohmann::json::object();
     JsonObject o(JsonValue(params, "/density", origin));
-    const DensityPtr density = type.read(o);
+    std::vector<InputFile> inputs;
+    const DensityPtr density = type.read(o)(inputs);
     ASSERT_NE(density, nullptr);
     int inside = 0;
     for (int b = 0; b < 300; ++b) {

@@ -10,6 +10,7 @@
 #include "nimbus/job/film_patch.h"
 #include "nimbus/job/fingerprint.h"
 #include "nimbus/job/work_queue.h"
+#include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
 
 namespace nimbus {
@@ -218,8 +219,8 @@ TEST(Fingerprint, NamesTheFirstSettingThatDiffers) {
 }
 
 // A resumed render must read the same grids: the fingerprint holds their files' hashes.
-// The files are those the loader recorded as it read them (issue 25: the fingerprint guessed
-// them from the JSON, one level under each medium): a density grid and a temperature grid.
+// The files are those compiling the scene recorded as it read them (issue 25: the fingerprint
+// guessed them from the JSON, one level under each medium): a density grid and a temperature grid.
 TEST(Fingerprint, HoldsEveryFileTheLoaderRead) {
   namespace fs = std::filesystem;
   const fs::path dir = fs::temp_directory_path() / ("nimbus_fp_" + std::to_string(::getpid()));
@@ -234,7 +235,10 @@ TEST(Fingerprint, HoldsEveryFileTheLoaderRead) {
     "objects": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "medium": "m"}]})";
   const std::string scene = (dir / "scene.json").string();
   const auto fingerprint = [&](const std::vector<std::string>& overrides) {
-    return render_fingerprint(load_scene_file(scene, overrides));
+    const SceneDesc desc = load_scene_file(scene, overrides);
+    std::vector<InputFile> inputs;
+    compile_scene(desc, {}, &inputs);
+    return render_fingerprint(desc, inputs);
   };
   const nlohmann::json before = fingerprint({"integrator.spp=8"});
   EXPECT_EQ(before["files"].size(), 2u) << before["files"];

@@ -22,6 +22,12 @@
 namespace nimbus {
 namespace {
 
+// The density a medium of a description makes when the scene is compiled.
+DensityPtr made_density(const MediumDesc& m) {
+  std::vector<InputFile> read;
+  return m.density(read);
+}
+
 // The example of docs/scene-format.md (its first json block), so that the documentation's
 // example is known to load.
 std::string documented_example() {
@@ -507,7 +513,8 @@ TEST(SceneLoad, ExampleLoads) {
   EXPECT_EQ(s.media[0].name, "cloud");
   EXPECT_EQ(s.media[0].phase.type, PhaseDesc::Type::HenyeyGreenstein);
   EXPECT_EQ(s.media[0].phase.g, 0.85);
-  const auto* cloud = dynamic_cast<const CloudDensity*>(s.media[0].density.get());
+  const DensityPtr cloud_density = made_density(s.media[0]);
+  const auto* cloud = dynamic_cast<const CloudDensity*>(cloud_density.get());
   ASSERT_NE(cloud, nullptr);
   EXPECT_EQ(cloud->params().seed, 7u);
   EXPECT_EQ(s.media[1].name, "fire");
@@ -515,7 +522,7 @@ TEST(SceneLoad, ExampleLoads) {
   EXPECT_EQ(s.media[1].phase.type, PhaseDesc::Type::Isotropic);
   EXPECT_EQ(s.media[2].name, "haze");
   EXPECT_EQ(s.media[2].sigma_a.rgb, Rgb(0.05));
-  EXPECT_NE(dynamic_cast<const FieldDensity*>(s.media[2].density.get()), nullptr);
+  EXPECT_NE(dynamic_cast<const FieldDensity*>(made_density(s.media[2]).get()), nullptr);
   EXPECT_EQ(s.media[2].density_scale, 2.0);
   EXPECT_EQ(s.media[3].name, "marble");
 
@@ -610,7 +617,7 @@ TEST(SceneLoad, DefaultsApplyWhereKeysAreOptional) {
   EXPECT_TRUE(s.lights.empty());
   ASSERT_EQ(s.media.size(), 1u);
   EXPECT_TRUE(s.media[0].sigma_s.rgb.is_black());
-  EXPECT_NE(dynamic_cast<const ConstantDensity*>(s.media[0].density.get()), nullptr);
+  EXPECT_NE(dynamic_cast<const ConstantDensity*>(made_density(s.media[0]).get()), nullptr);
   EXPECT_EQ(s.media[0].density_scale, 1.0);
   EXPECT_EQ(s.objects[0].shape_name, "inline");
   EXPECT_EQ(s.objects[0].surface.type, SurfaceDesc::Type::Diffuse);

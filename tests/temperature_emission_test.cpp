@@ -220,13 +220,13 @@ INSTANTIATE_TEST_SUITE_P(Modes, TemperatureGrid, testing::Values("rgb", "spectra
                            return info.param;
                          });
 
-// The load error of a scene in `dir` whose medium "m" has the given emission.
+// The error of a scene in `dir` whose medium "m" has the given emission.
 std::string load_error(const TempDir& dir, const std::string& emission) {
   std::ofstream(dir.file("scene.json"))
       << R"({"camera": {"from": [0, 0, 5], "to": [0, 0, 0]}, "media": {"m": {"sigma_a": 1, )"
       << R"("emission": )" << emission << "}}}";
   try {
-    load_scene_file(dir.file("scene.json"));
+    compile_scene(load_scene_file(dir.file("scene.json")));  // the grid is read by compiling
   } catch (const SceneError& e) {
     return e.what();
   }

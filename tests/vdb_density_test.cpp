@@ -317,13 +317,13 @@ TEST(VdbDensity, DoubleGridsInactiveAndNegativeValues) {
   EXPECT_NEAR(r.hi, 2.0, 1e-12);
 }
 
-// The load error of a scene in `dir` whose medium has the given density.
+// The error of a scene in `dir` whose medium has the given density.
 std::string load_error(const TempDir& dir, const std::string& density) {
   std::ofstream(dir.file("scene.json"))
       << R"({"camera": {"from": [0, 0, 5], "to": [0, 0, 0]}, "media": {"m": {"density": )"
       << density << "}}}";
   try {
-    load_scene_file(dir.file("scene.json"));
+    compile_scene(load_scene_file(dir.file("scene.json")));  // the grid is read by compiling
   } catch (const SceneError& e) {
     return e.what();
   }

@@ -75,13 +75,13 @@ std::string file_difference(const nlohmann::json& saved, const nlohmann::json& n
 
 }  // namespace
 
-nlohmann::json render_fingerprint(const SceneDesc& desc) {
+nlohmann::json render_fingerprint(const SceneDesc& desc, const std::vector<InputFile>& inputs) {
   nlohmann::json scene = desc.document;
   if (scene.is_object() && scene.contains("integrator") && scene["integrator"].is_object())
     scene["integrator"].erase("spp");
-  // Each file under the JSON pointer that named it, as the loader recorded it when it read it.
+  // Each file under the JSON pointer that named it, as compiling recorded it when it read it.
   nlohmann::json files = nlohmann::json::object();
-  for (const InputFile& f : desc.inputs)
+  for (const InputFile& f : inputs)
     files[f.pointer] = {
         {"file", f.path}, {"bytes", f.bytes}, {"hash", fmt::format("{:016x}", f.hash)}};
   return {{"nimbus", NIMBUS_VERSION}, {"scene", scene}, {"files", files}};

@@ -1,23 +1,24 @@
 #pragma once
 // What a checkpoint must match to be continued (job/checkpoint.h): everything that changes a
 // pixel's samples. The scene's document as loaded, after the --set overrides (--seed included),
-// without integrator.spp, which only says how many samples to take; the record of every file the
-// loader read for it (SceneDesc::inputs: VDB grids, wherever the document names them, with their
-// sizes and hashes taken as they were read); the nimbus version. Not the threads, the processes
-// or the outputs, which change no pixel. Nothing is read or parsed again.
+// without integrator.spp, which only says how many samples to take; the record of every file
+// compiling it read (compile_scene's `inputs`: VDB grids, wherever the document names them, with
+// their sizes and hashes taken as they were read); the nimbus version. Not the threads, the
+// processes or the outputs, which change no pixel. Nothing is read or parsed again.
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "nimbus/render/scene.h"
 #include "nimbus/scene/scene_desc.h"
 
 namespace nimbus {
 
-// The fingerprint of a loaded description. A description built in code has no document: pass
-// `identity`, any JSON that changes when the scene does, to stand for it.
-nlohmann::json render_fingerprint(const SceneDesc& desc);
+// The fingerprint of a loaded description whose compilation read `inputs`. A scene built in code
+// has no document: pass `identity`, any JSON that changes when the scene does, to stand for it.
+nlohmann::json render_fingerprint(const SceneDesc& desc, const std::vector<InputFile>& inputs);
 nlohmann::json render_fingerprint(const nlohmann::json& identity);
 
 // "" when equal; else the first difference in words: "KEY: A in the checkpoint, B now" with KEY

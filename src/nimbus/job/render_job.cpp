@@ -29,7 +29,7 @@ void RenderJob::prepare(const std::string& scene_file, const BuildMonitor& monit
   load(scene_file, read_resume());
   check();
   if (!compile(monitor)) return;
-  check_majorants();
+  check_compiled();
 }
 
 int RenderJob::read_resume() {
@@ -49,7 +49,6 @@ void RenderJob::load(const std::string& scene_file, int spp) {
   if (options_.seed) overrides.push_back(fmt::format("integrator.seed={}", *options_.seed));
   desc_ = load_scene_file(scene_file, overrides);
   scene_file_ = scene_file;
-  fingerprint_ = render_fingerprint(desc_);
   compiled_ = false;
 }
 
@@ -65,7 +64,7 @@ void RenderJob::set_scene(Scene scene, const nlohmann::json& identity) {
                                                    {"max_depth", scene_.settings.max_depth}});
   compiled_ = true;
   check();
-  check_majorants();
+  check_compiled();
 }
 
 void RenderJob::check() const {
@@ -74,7 +73,14 @@ void RenderJob::check() const {
   const int spp = compiled_ ? scene_.settings.spp : desc_.settings.spp;
   if (resumed_) {
     const std::string& file = options_.resume;
-    if (const std::string d = fingerprint_difference(resumed_->fingerprint, fingerprint_);
+    // The document and the settings now; the files it reads once they are read (check_compiled).
+    const auto without_files = [](nlohmann::json j) {
+      if (j.is_object()) j.erase("files");
+      return j;
+    };
+    const nlohmann::json now = compiled_ ? fingerprint_ : render_fingerprint(desc_, {});
+    if (const std::string d =
+            fingerprint_difference(without_files(resumed_->fingerprint), without_files(now));
         !d.empty())
       throw JobError(fmt::format(
           "--resume {}: the checkpoint is of another scene or other settings ({})", file, d));
@@ -93,17 +99,23 @@ void RenderJob::check() const {
 }
 
 bool RenderJob::compile(const BuildMonitor& monitor) {
-  scene_ = compile_scene(desc_, monitor);
+  scene_ = compile_scene(desc_, monitor, &inputs_);
+  fingerprint_ = render_fingerprint(desc_, inputs_);
   compiled_ = !(monitor.cancel && monitor.cancel());
   return compiled_;
 }
 
-void RenderJob::check_majorants() const {
-  if (resumed_ && resumed_->majorants != majorant_hash(scene_))
+void RenderJob::check_compiled() const {
+  if (!resumed_) return;
+  const std::string& file = options_.resume;
+  if (const std::string d = fingerprint_difference(resumed_->fingerprint, fingerprint_); !d.empty())
+    throw JobError(fmt::format(
+        "--resume {}: the checkpoint is of another scene or other settings ({})", file, d));
+  if (resumed_->majorants != majorant_hash(scene_))
     throw JobError(fmt::format(
         "--resume {}: the checkpoint's majorant octrees differ from this render's (another "
         "nimbus build?)",
-        options_.resume));
+        file));
 }
 
 JobOutcome RenderJob::run(JobChannel* channel) {
@@ -209,7 +221,7 @@ std::string RenderJob::summary(const JobOutcome& outcome) const {
 std::vector<NamedFile> RenderJob::files_read() const {
   std::vector<NamedFile> read;
   if (!scene_file_.empty()) read.push_back({"the scene file", scene_file_});
-  for (const InputFile& f : desc_.inputs) read.push_back({"the file of " + f.pointer, f.path});
+  for (const InputFile& f : inputs_) read.push_back({"the file of " + f.pointer, f.path});
   if (!options_.resume.empty() && !options_.checkpoint.empty() &&
       !same_file(options_.resume, options_.checkpoint))
     read.push_back({"the checkpoint of --resume", options_.resume});
@@ -225,7 +237,8 @@ std::vector<NamedFile> RenderJob::files_written() const {
 void check_render_memory(const SceneDesc& desc, int threads, std::optional<uint64_t> max_memory) {
   int octrees = 1;  // the field's, and one per solid holding a medium (render/scene.h)
   for (const ObjectDesc& o : desc.objects) octrees += has_own_octree(o.medium, o.surface.type);
-  const int bins = desc.settings.spectral.mode == SpectralSettings::Mode::Spectral ? kSpectralBins : 3;
+  const int bins =
+      desc.settings.spectral.mode == SpectralSettings::Mode::Spectral ? kSpectralBins : 3;
   const int workers = threads > 0 ? threads : int(std::thread::hardware_concurrency());
   const MemoryEstimate need =
       estimate_render_memory(desc.settings.width, desc.settings.height, octrees, bins, workers);

@@ -11,8 +11,8 @@
 //   JobOutcome r = job.run();          // r.film; r.stopped if cancelled
 //
 // Processes of one job call the steps of prepare themselves, agreeing between them: the lead
-// (rank 0) alone reads the checkpoint (read_resume) and checks (check); every process loads and
-// compiles; the lead runs, the others work.
+// (rank 0) alone reads the checkpoint (read_resume) and checks (check, check_compiled); every
+// process loads and compiles; the lead runs, the others work.
 
 #include <cstdint>
 #include <functional>
@@ -71,7 +71,7 @@ class RenderJob {
  public:
   explicit RenderJob(RenderJobOptions options);
 
-  // read_resume (lead), load, check (lead) and compile, for a job in one process.
+  // read_resume, load, check, compile and check_compiled, for a job in one process.
   void prepare(const std::string& scene_file, const BuildMonitor& monitor = {});
   // A scene built in code (compiled, finish_scene called) instead of a file: `identity`, any
   // JSON that changes when the scene does, stands for the scene in checkpoints. Checks as check.
@@ -82,13 +82,15 @@ class RenderJob {
   int read_resume();
   // Loads the scene file with the overrides, `spp` (if > 0) and the seed. SceneError.
   void load(const std::string& scene_file, int spp);
-  // The lead's: the checkpoint to continue is of this scene, and the memory suffices. JobError.
+  // The lead's: the memory suffices, and the checkpoint to continue is of this scene's document
+  // and settings, with its film size and no pixel past its spp. JobError.
   void check() const;
-  // Compiles the scene (reads its files, builds the majorant octrees); false if the monitor
-  // cancelled it. SceneError.
+  // Compiles the scene (reads its files and records them, builds the majorant octrees); false if
+  // the monitor cancelled it. SceneError.
   bool compile(const BuildMonitor& monitor = {});
-  // The lead's, once compiled: the resumed checkpoint's octrees are this scene's. JobError.
-  void check_majorants() const;
+  // The lead's, once compiled: the checkpoint to continue read the same files, and built the
+  // same majorant octrees. JobError.
+  void check_compiled() const;
 
   // The lead's (rank 0 of `channel`, or the only process): renders to spp.
   JobOutcome run(JobChannel* channel = nullptr);
@@ -100,7 +102,7 @@ class RenderJob {
   // "64x48, 16 spp in 0.52 s (9.1e+04 samples/s, 2 threads)", with the processes if several.
   std::string summary(const JobOutcome& outcome) const;
 
-  // The files the job reads (the scene file, those its description named, the checkpoint it
+  // The files the job reads (the scene file, those compiling it read, the checkpoint it
   // continues) and writes (checkpoints), for io/output.h's check_outputs_distinct.
   std::vector<NamedFile> files_read() const;
   std::vector<NamedFile> files_written() const;
@@ -120,6 +122,7 @@ class RenderJob {
   std::string scene_file_;
   std::optional<Checkpoint> resumed_;
   SceneDesc desc_;
+  std::vector<InputFile> inputs_;  // the files compiling the description read
   Scene scene_;
   nlohmann::json fingerprint_;
   bool compiled_ = false;

@@ -29,14 +29,14 @@ Surface compile_surface(const SurfaceDesc& d) {
   return s;
 }
 
-Medium compile_medium(const MediumDesc& d) {
+Medium compile_medium(const MediumDesc& d, std::vector<InputFile>& inputs) {
   Medium m;
   m.sigma_a = d.sigma_a;
   m.sigma_s = d.sigma_s;
   m.emission = d.emission;
-  m.emission_grid = d.emission_grid;
+  if (d.emission_grid) m.emission_grid = d.emission_grid(inputs);
   m.g = d.phase.type == PhaseDesc::Type::HenyeyGreenstein ? d.phase.g : 0.0;
-  m.density = d.density;
+  m.density = d.density(inputs);
   m.scale = d.density_scale;
   return m;
 }
@@ -80,12 +80,15 @@ double null_thickness_bound(const Scene& scene, size_t object) {
 
 }  // namespace
 
-Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor) {
+Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
+                    std::vector<InputFile>* inputs) {
+  std::vector<InputFile> read;
   Scene scene;
   scene.settings = desc.settings;
   scene.camera = compile_camera(desc.camera, desc.settings);
 
-  for (const MediumDesc& md : desc.media) scene.media.push_back(compile_medium(md));
+  for (const MediumDesc& md : desc.media) scene.media.push_back(compile_medium(md, read));
+  if (inputs) *inputs = std::move(read);
 
   int field_objects = 0;  // finish_scene lists them; here they are counted for the message
   std::vector<const ObjectDesc*> object_descs;  // of each compiled object, for messages

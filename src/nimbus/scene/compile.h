@@ -2,7 +2,10 @@
 // Compiles a validated scene description into the flat run-time Scene: shapes to tapes with
 // bounds, lights and surfaces to their run-time forms.
 
+#include <vector>
+
 #include "nimbus/render/scene.h"
+#include "nimbus/scene/input_file.h"
 #include "nimbus/scene/scene_desc.h"
 
 namespace nimbus {
@@ -19,8 +22,11 @@ inline constexpr double kMaxOpticalThickness = 1e6;
 // object whose shape is unbounded or a medium that may cost more than kMaxOpticalThickness null
 // collisions per ray.
 // The monitor watches the majorant octrees' build, the part that can take seconds
-// (media/octree.h); a cancelled compile returns a scene that must not be rendered.
-Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor = {});
+// (media/octree.h); a cancelled compile returns a scene that must not be rendered. Reads the
+// files the description names (VDB grids) and records them in `inputs`, in the order read: what
+// a render's fingerprint holds and its outputs must not overwrite.
+Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor = {},
+                    std::vector<InputFile>* inputs = nullptr);
 
 // What a scene needs before it renders, derived from its objects, media, lights and settings:
 // the list of index-matched medium objects, the scene's size, every colour's spectrum and the

@@ -11,17 +11,17 @@
 namespace nimbus {
 namespace {
 
-DensityPtr read_constant(JsonObject&) {
-  return make_constant_density();
+DensityMaker read_constant(JsonObject&) {
+  return [](std::vector<InputFile>&) { return make_constant_density(); };
 }
 
-DensityPtr read_field(JsonObject&) {
-  return make_field_density();
+DensityMaker read_field(JsonObject&) {
+  return [](std::vector<InputFile>&) { return make_field_density(); };
 }
 
 // docs/scene-format.md: noise octaves and base frequency, erosion depth in [0, 1), the F over
 // which the profile rises from 0 to 1, and the noise seed (0 in scene files).
-DensityPtr read_cloud(JsonObject& d) {
+DensityMaker read_cloud(JsonObject& d) {
   CloudParams p;
   p.seed = 0;
   if (auto y = d.optional("octaves")) p.octaves = y->integer(between(1, 16));
@@ -29,34 +29,29 @@ DensityPtr read_cloud(JsonObject& d) {
   if (auto y = d.optional("amplitude")) p.amplitude = y->number(Range{0.0, 1.0, false, true});
   if (auto y = d.optional("edge")) p.edge = y->number(above(0));
   if (auto y = d.optional("seed")) p.seed = y->unsigned_integer();
-  return make_cloud_density(p);
+  return [p](std::vector<InputFile>&) { return make_cloud_density(p); };
 }
 
 // docs/scene-format.md: a grid of a .vdb or .nvdb file (relative to the scene file's folder), by
-// name, moved further by an optional transform. The file is read here, so that every problem
-// with it is a load error naming the key at fault and the file.
-DensityPtr read_vdb(JsonObject& d) {
+// name, moved further by an optional transform. The file is read when the scene is compiled;
+// every problem with it is then one line naming the key at fault and the file.
+DensityMaker read_vdb(JsonObject& d) {
   const JsonValue file = d.required("file");
   const auto grid = d.optional("grid");
   const auto transform = d.optional("transform");
-  VdbParams p;
+  GridInput in;
   const std::filesystem::path path = file.string();
   if (path.empty()) file.fail("must name a file");
-  p.file = (std::filesystem::path(d.value().origin().folder) / path).string();
-  if (grid) p.grid = grid->string();
-  if (p.grid.empty()) grid->fail("must name a grid");
-  if (transform) p.transform = read_transform(*transform);
-  // A misspelt key is reported as such before the file is read with a default in its place.
+  in.params.file = (std::filesystem::path(d.value().origin().folder) / path).string();
+  if (grid) in.params.grid = grid->string();
+  if (in.params.grid.empty()) grid->fail("must name a grid");
+  if (transform) in.params.transform = read_transform(*transform);
   d.finish(R"(for density type "vdb")");
-  file.record_input(p.file);
-  try {
-    return make_vdb_density(p);
-  } catch (const VdbError& e) {
-    // A problem of the grid is blamed on "grid", or on the density when the default was used.
-    if (e.key != "grid") file.fail(e.what());
-    if (grid) grid->fail(e.what());
-    d.fail(e.what());
-  }
+  in.file_pointer = file.pointer();
+  in.file_blame = file.blame();
+  if (grid) in.grid_blame = grid->blame();
+  in.object_blame = d.value().blame();
+  return [in](std::vector<InputFile>& inputs) { return in.read(inputs, make_vdb_density); };
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "nimbus/media/temperature_emission.h"
+#include "nimbus/scene/input_file.h"
 #include "nimbus/scene/json_reader.h"
 
 namespace nimbus {
@@ -14,8 +15,12 @@ namespace nimbus {
 // Whether an "emission" value is a temperature grid rather than a colour.
 bool is_emission_grid(const JsonValue& v);
 
-// Reads the keys and the grid; every problem, the file's included, is one SceneError line at
-// the key at fault (the emission's own pointer for a problem of the default grid).
-std::shared_ptr<const TemperatureEmission> read_emission_grid(const JsonValue& v);
+// How a temperature grid is made once the scene is compiled, which reads its file.
+using EmissionGridMaker = Deferred<std::shared_ptr<const TemperatureEmission>>;
+
+// Reads and checks the keys; the grid is read by the maker, and every problem, the file's
+// included, is one SceneError line at the key at fault (the emission's own pointer for a
+// problem of the default grid).
+EmissionGridMaker read_emission_grid(const JsonValue& v);
 
 }  // namespace nimbus

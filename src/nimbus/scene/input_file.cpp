@@ -1,9 +1,12 @@
 #include "nimbus/scene/input_file.h"
 
+#include <fmt/format.h>
+
 #include <fstream>
 #include <vector>
 
 #include "nimbus/math/fnv.h"
+#include "nimbus/scene/json_reader.h"
 
 namespace nimbus {
 
@@ -22,6 +25,13 @@ InputFile record_input_file(const std::string& pointer, const std::string& path)
   f.bytes = bytes;
   f.hash = h;
   return f;
+}
+
+void GridInput::fail(const VdbError& e) const {
+  const std::string& at = e.key != "grid"       ? file_blame
+                          : !grid_blame.empty() ? grid_blame
+                                                : object_blame;
+  throw SceneError(fmt::format("{}: {}", at, e.what()));
 }
 
 }  // namespace nimbus

@@ -68,13 +68,17 @@ std::string child_pointer(const std::string& pointer, std::string_view key) {
   return out;
 }
 
-void JsonValue::fail(std::string_view problem) const {
+std::string JsonValue::blame() const {
   std::string origin = origin_->source;
   for (const auto& o : origin_->overrides) {
     const bool inside = pointer_ == o.pointer || (pointer_.rfind(o.pointer + "/", 0) == 0);
     if (inside) origin = o.flag;  // the last override of a value is the one in effect
   }
-  throw SceneError(fmt::format("{}: {}: {}", origin, pointer_.empty() ? "/" : pointer_, problem));
+  return fmt::format("{}: {}", origin, pointer_.empty() ? "/" : pointer_);
+}
+
+void JsonValue::fail(std::string_view problem) const {
+  throw SceneError(fmt::format("{}: {}", blame(), problem));
 }
 
 namespace {
@@ -125,10 +129,6 @@ std::string printable_line(std::string_view text) {
   while (tail < out.size() && (static_cast<unsigned char>(out[tail]) >> 6) == 0x2) ++tail;
   return fmt::format("{} ... ({} bytes in all) ... {}", out.substr(0, head), text.size(),
                      out.substr(tail));
-}
-
-void JsonValue::record_input(const std::string& path) const {
-  if (origin_->inputs) origin_->inputs->push_back(record_input_file(pointer_, path));
 }
 
 void JsonValue::check(double x, const Range& range) const {

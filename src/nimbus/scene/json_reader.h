@@ -15,7 +15,6 @@
 
 #include "nimbus/math/range.h"
 #include "nimbus/math/vec3.h"
-#include "nimbus/scene/input_file.h"
 #include "nimbus/spectral/spectrum.h"
 
 namespace nimbus {
@@ -46,9 +45,6 @@ struct JsonOrigin {
   // The folder that relative file names in the document resolve against: the scene file's own;
   // "" (the current directory) for a document that is not a file.
   std::string folder = "";
-  // Where the loader records each file it reads, as it reads it (SceneDesc::inputs); none: not
-  // recorded.
-  std::vector<InputFile>* inputs = nullptr;
 };
 
 // One JSON value and its JSON pointer ("" for the document itself).
@@ -60,8 +56,9 @@ class JsonValue {
   const nlohmann::json& json() const { return *json_; }
   const std::string& pointer() const { return pointer_; }
   const JsonOrigin& origin() const { return *origin_; }
-  // Records that this value, a file name, made the loader read `path` (JsonOrigin::inputs).
-  void record_input(const std::string& path) const;
+  // "ORIGIN: POINTER", the start of fail()'s message: for a problem found once the document is
+  // gone (a file read when the scene is compiled, scene/input_file.h).
+  std::string blame() const;
 
   // Throws SceneError("ORIGIN: POINTER: problem").
   [[noreturn]] void fail(std::string_view problem) const;

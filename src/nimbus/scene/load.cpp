@@ -690,12 +690,10 @@ namespace {
 // that is not a file.
 SceneDesc load_json_in(nlohmann::json j, const std::string& source, const std::string& folder,
                        const std::vector<std::string>& overrides) {
-  std::vector<InputFile> inputs;
-  JsonOrigin origin{source, {}, folder, &inputs};
+  JsonOrigin origin{source, {}, folder};
   for (const std::string& o : overrides)
     origin.overrides.push_back({apply_override(j, o), set_flag(o)});
   SceneDesc scene = Loader(JsonValue(j, "", origin)).load();
-  scene.inputs = std::move(inputs);
   scene.document = std::move(j);
   return scene;
 }

@@ -1,7 +1,8 @@
 #pragma once
 // The scene as the scene file states it, validated (scene/load.h) and nothing more: plain
-// structs with the file's defaults. Compilation into run-time structures happens elsewhere and
-// trusts these values; docs/scene-format.md documents every field.
+// structs with the file's defaults. Loading reads no file but the scene file: what a grid file
+// holds is read by compile_scene (scene/input_file.h), which builds the run-time Scene and trusts
+// these values; docs/scene-format.md documents every field.
 
 #include <cstdint>
 #include <memory>
@@ -41,10 +42,13 @@ struct PhaseDesc {
 struct MediumDesc {
   std::string name;
   SpectralParam sigma_a, sigma_s, emission;
-  // Set: the emission is a temperature grid's (media/temperature_emission.h).
-  std::shared_ptr<const TemperatureEmission> emission_grid;
+  // Set: the emission is a temperature grid's (media/temperature_emission.h), read from its file
+  // when the scene is compiled.
+  Deferred<std::shared_ptr<const TemperatureEmission>> emission_grid;
   PhaseDesc phase;
-  DensityPtr density = make_constant_density();  // made by its type's reader (density_types.h)
+  // How compile_scene makes the density (its type's reader, scene/density_types.h, checked the
+  // keys; a "vdb" density's file is read then).
+  Deferred<DensityPtr> density = [](std::vector<InputFile>&) { return make_constant_density(); };
   double density_scale = 1;
 };
 
@@ -73,11 +77,9 @@ struct SceneDesc {
   std::vector<Light> lights;
   std::vector<MediumDesc> media;
   std::vector<ObjectDesc> objects;
-  // Every file the description made the loader read, in the order read (not the scene file
-  // itself): what a render's outputs must not overwrite.
-  std::vector<InputFile> inputs;
-  // The document as loaded, after the overrides (null for a description built in code): with
-  // `inputs`, what the render is of (job/fingerprint.h), without a second parse.
+  // The document as loaded, after the overrides (null for a description built in code): with the
+  // files that compiling it reads, what the render is of (job/fingerprint.h), without a second
+  // parse.
   nlohmann::json document;
 };
 
