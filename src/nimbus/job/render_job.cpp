@@ -44,10 +44,12 @@ int RenderJob::read_resume() {
 }
 
 void RenderJob::load(const std::string& scene_file, int spp) {
+  // The seed is part of what the render is of (the document, hence the fingerprint); spp only
+  // says how many samples to take, and goes to the settings as it is.
   std::vector<std::string> overrides = options_.overrides;
-  if (spp > 0) overrides.push_back(fmt::format("integrator.spp={}", spp));
   if (options_.seed) overrides.push_back(fmt::format("integrator.seed={}", *options_.seed));
   desc_ = load_scene_file(scene_file, overrides);
+  if (spp > 0) desc_.settings.spp = spp;
   scene_file_ = scene_file;
   compiled_ = false;
 }
