@@ -370,6 +370,14 @@ TEST_F(Cli, RendersThatWouldNotFitAreRefusedUpFront) {
                        "\" is not a size (a positive number with K, M, G or T)\n");
   EXPECT_TRUE(outputs().empty());
   EXPECT_EQ(run("render scene.json --max-memory 1.5G --spp 1 -o a.png").code, 0);
+  // Issue 29: a scene without media was charged 42 MiB of octrees, so --max-memory 32M refused
+  // a 16 x 16 render of it.
+  write("plain.json", R"({"film": {"width": 16, "height": 16},
+    "camera": {"from": [0, 0, 4], "to": [0, 0, 0]},
+    "lights": [{"type": "environment", "radiance": 1}],
+    "objects": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}}]})");
+  const Ran plain = run("render plain.json --max-memory 32M --spp 1 -o p.png");
+  EXPECT_EQ(plain.code, 0) << plain.err;
 }
 
 TEST_F(Cli, OutputIsTheSameForOneAndTwoThreads) {

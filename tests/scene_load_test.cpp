@@ -740,6 +740,30 @@ TEST(SceneLoad, MessagesAreOnePrintableBoundedLine) {
   EXPECT_LE(message.size(), kMaxMessageBytes);
 }
 
+// Issue 29: 200 000 nested arrays (400 KB) took 24 GB before the depth was checked, memory
+// growing with the square of the depth. The depth is checked while parsing: a file or a --set
+// value nested past kMaxJsonDepth is refused with one line, at once.
+TEST(SceneLoad, DocumentsNestedTooDeeplyAreRefusedWhileParsing) {
+  const std::string deep = std::string(200000, '[') + std::string(200000, ']');
+  try {
+    load_scene_text(with_camera(R"("shapes": {"s": )" + deep + "}"), "scene.json");
+    ADD_FAILURE() << "a document nested 200 000 deep was accepted";
+  } catch (const SceneError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind("scene.json: /shapes/s/0/0/0/", 0), 0u) << m.substr(0, 300);
+    EXPECT_NE(m.find("/.../"), std::string::npos) << m.substr(0, 300);
+    EXPECT_NE(m.find(": arrays and objects nest deeper than 1024 levels"), std::string::npos)
+        << m.substr(0, 300);
+    EXPECT_LT(m.size(), 400u);
+  }
+  try {
+    load_scene_text(with_camera(""), "scene.json", {"shapes.s=" + deep});
+    ADD_FAILURE() << "a --set value nested 200 000 deep was accepted";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("nest deeper than 1024 levels"), std::string::npos);
+  }
+}
+
 // Issue 29: numbers past a double had no JSON path ("number overflow parsing '1e400'") or became
 // strings through --set ("not a string"), a seed past 2^64 - 1 was "a fraction", and duplicate
 // keys in a --set value were accepted.
@@ -771,7 +795,8 @@ TEST(SceneLoad, NumbersOutOfRangeAndDuplicateKeysInSetAreNamed) {
 
 TEST(SceneLoad, DeeplyNestedShapesAreAnErrorNotACrash) {
   std::string text = R"({"type": "sphere", "radius": 1})";
-  for (int i = 0; i < 5000; ++i) text = R"({"type": "union", "shapes": [)" + text + "]}";
+  // 300 levels: past kMaxShapeDepth, within kMaxJsonDepth (2 JSON levels a union).
+  for (int i = 0; i < 300; ++i) text = R"({"type": "union", "shapes": [)" + text + "]}";
   const std::string nested = load_error(with_object(R"({"shape": )" + text + "}"));
   std::string at = "/objects/0/shape";
   for (int i = 0; i < kMaxShapeDepth; ++i) at += "/shapes/0";

@@ -237,8 +237,16 @@ std::vector<NamedFile> RenderJob::files_written() const {
 }
 
 void check_render_memory(const SceneDesc& desc, int threads, std::optional<uint64_t> max_memory) {
-  int octrees = 1;  // the field's, and one per solid holding a medium (render/scene.h)
-  for (const ObjectDesc& o : desc.objects) octrees += has_own_octree(o.medium, o.surface.type);
+  // One per solid holding a medium, and the field's if an index-matched object holds one
+  // (render/scene.h); none for a scene without media (issue 29: 42 MiB were charged for it).
+  int octrees = 0;
+  bool field = false;
+  for (const ObjectDesc& o : desc.objects) {
+    const int medium = compiled_medium(o);
+    octrees += has_own_octree(medium, o.surface.type);
+    field = field || (medium >= 0 && !has_own_octree(medium, o.surface.type));
+  }
+  octrees += field;
   const int bins =
       desc.settings.spectral.mode == SpectralSettings::Mode::Spectral ? kSpectralBins : 3;
   const int workers = threads > 0 ? threads : int(std::thread::hardware_concurrency());

@@ -101,7 +101,8 @@ std::vector<Setting> make_settings() {
           [](auto& s) -> auto& { return s.tracking.mode; }),
       choice(
           "integrator.absorption", "absorption", kAbsorptionNames,
-          "absorption carried by the weights, or sampled as an event that ends the path",
+          "absorption carried by the weights, or an event that ends the path (spectral-mis: "
+          "always)",
           [](auto& s) -> auto& { return s.tracking.absorption; }),
       boolean(
           "integrator.decomposition",

@@ -80,6 +80,12 @@ double null_thickness_bound(const Scene& scene, size_t object) {
 
 }  // namespace
 
+int compiled_medium(const ObjectDesc& o) {
+  return o.surface.type == Surface::Type::Diffuse || o.surface.type == Surface::Type::Emissive
+             ? -1
+             : o.medium;
+}
+
 Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
                     std::vector<InputFile>* inputs) {
   std::vector<InputFile> read;
@@ -103,11 +109,7 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
     if (b.box.empty()) continue;  // nothing is inside: the object cannot be seen
     obj.bounds = b.box;
     obj.surface = compile_surface(od.surface);
-    // An opaque surface hides its medium; only solids and index-matched objects hold one.
-    obj.medium =
-        obj.surface.type == Surface::Type::Diffuse || obj.surface.type == Surface::Type::Emissive
-            ? -1
-            : od.medium;
+    obj.medium = compiled_medium(od);
     if (obj.surface.type == Surface::Type::None && obj.medium >= 0) {
       if (++field_objects > kMaxMediaAtPoint)
         throw SceneError(

@@ -28,6 +28,10 @@ inline constexpr double kMaxOpticalThickness = 1e6;
 Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor = {},
                     std::vector<InputFile>* inputs = nullptr);
 
+// The medium an object of the description holds once compiled: its own, or -1 where an opaque
+// surface (diffuse, emissive) hides it; only solids and index-matched objects hold one.
+int compiled_medium(const ObjectDesc& object);
+
 // What a scene needs before it renders, derived from its objects, media, lights and settings:
 // the list of index-matched medium objects, the scene's size, every colour's spectrum and the
 // majorant octrees. compile_scene calls it; a scene built in code calls it once it is complete

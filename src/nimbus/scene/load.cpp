@@ -553,6 +553,13 @@ class DuplicateKeys {
     const Frame& f = frames_.back();
     return child_pointer(f.pointer, f.array ? std::to_string(f.index + 1) : f.key);
   }
+  // next_value_pointer, its middle cut out past a few hundred characters (a deep document's).
+  std::string next_value_pointer_cut() const {
+    const std::string p = next_value_pointer();
+    if (p.size() <= 200) return p;
+    return fmt::format("{}/.../{}", p.substr(0, p.find('/', 80)),
+                       p.substr(p.rfind('/', p.size() - 60) + 1));
+  }
   // For nlohmann::json::parse, which copies its callback: this object keeps the state.
   nlohmann::json::parser_callback_t callback() {
     return [this](int depth, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
@@ -564,6 +571,9 @@ class DuplicateKeys {
     switch (event) {
       case E::object_start:
       case E::array_start:
+        if (frames_.size() >= size_t(kMaxJsonDepth))
+          throw SceneError(fmt::format("{}: {}: arrays and objects nest deeper than {} levels",
+                                       source_, next_value_pointer_cut(), kMaxJsonDepth));
         enter_element();
         frames_.push_back({event == E::array_start,
                            -1,

@@ -18,6 +18,12 @@ namespace nimbus {
 // How deeply shapes may nest in a scene file (docs/scene-format.md).
 inline constexpr int kMaxShapeDepth = 256;
 
+// How deeply arrays and objects may nest in a scene file's JSON (or a --set value), checked while
+// parsing: room for kMaxShapeDepth levels of shapes (two JSON levels each: a node and its list of
+// children) and the sections around them. Deeper documents are refused before they cost memory
+// in proportion to the square of their depth (issue 29: 200 000 nested arrays took 24 GB).
+inline constexpr int kMaxJsonDepth = 4 * kMaxShapeDepth;
+
 // The largest scene file read: far above any scene written by hand or exported, far below
 // what would exhaust memory.
 inline constexpr std::uintmax_t kMaxSceneFileBytes = std::uintmax_t{64} << 20;
