@@ -19,6 +19,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <new>
 #include <optional>
 #include <string>
 #include <thread>
@@ -715,6 +716,14 @@ int run_command(int argc, char** argv, const Cluster& cluster) {
     catch_stop_signals();
     if (export_vdb->parsed()) return run_export_vdb(exp_vdb);
     return run_render(args, cluster);
+  } catch (const std::bad_alloc&) {
+    // Past the estimate (render/memory_estimate.h), e.g. a --max-memory above what the machine
+    // has (issue 29: "nimbus: std::bad_alloc").
+    std::fprintf(stderr,
+                 "nimbus: out of memory: the machine could not give what the run needed "
+                 "(does --max-memory allow more than it has?)\n");
+    if (cluster.size > 1) cluster_abort(kExitFailure);
+    return kExitFailure;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "nimbus: %s\n", nimbus::printable_line(e.what()).c_str());
     // The other ranks may be waiting for this one: end them all.

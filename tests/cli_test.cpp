@@ -380,6 +380,28 @@ TEST_F(Cli, RendersThatWouldNotFitAreRefusedUpFront) {
   EXPECT_EQ(plain.code, 0) << plain.err;
 }
 
+// Issue 29: --max-memory above what the machine can give ended in "nimbus: std::bad_alloc". Under
+// an address-space limit of 1.5 GB, a 16384 x 16384 render allowed 100 GB ends in one line.
+TEST_F(Cli, OutOfMemoryIsOneLine) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer cannot start under an address-space limit";
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+  GTEST_SKIP() << "AddressSanitizer cannot start under an address-space limit";
+#endif
+#endif
+  write("scene.json", good_scene().dump());
+  const Ran r =
+      nimbus::testing::run_in(dir_, std::string("ulimit -v 1500000 && '") + NIMBUS_BINARY +
+                                        "' render scene.json --set film.width=16384 --set "
+                                        "film.height=16384 --max-memory 100G -q -o a.png");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(r.err,
+            "nimbus: out of memory: the machine could not give what the run needed (does "
+            "--max-memory allow more than it has?)\n");
+  EXPECT_TRUE(outputs().empty());
+}
+
 TEST_F(Cli, OutputIsTheSameForOneAndTwoThreads) {
   write("scene.json", good_scene().dump());
   ASSERT_EQ(run("render scene.json -o one.exr --threads 1 --quiet").code, 0);

@@ -482,6 +482,22 @@ TEST(SceneLoad, DenseGrayMediaCompileAndDenseChromaticOnesAreRefused) {
               0u)
         << e.what();
   }
+  // Issue 29: a majorant scale of 10^7 on a thin field medium rendered as if hung; the guard now
+  // sees the scale.
+  const std::string field = with_camera(
+      R"("media": {"m": {"sigma_s": 1, "density": {"type": "field"}}}, "objects": [{"shape": )"
+      R"({"type": "sphere", "radius": 1}, "surface": {"type": "none"}, "medium": "m"}])");
+  EXPECT_NO_THROW(compile_scene(load(field, {"integrator.majorant.scale=1e4"})));
+  try {
+    compile_scene(load(field, {"integrator.majorant.scale=1e7"}));
+    ADD_FAILURE() << "a majorant scale of 1e7 compiled";
+  } catch (const SceneError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind("scene.json: /objects/0/medium: medium \"m\" may cost ", 0), 0u) << m;
+    EXPECT_NE(m.find("(integrator.majorant.scale 1e+07 multiplies the majorants)"),
+              std::string::npos)
+        << m;
+  }
 }
 
 TEST(SceneLoad, ExampleLoads) {

@@ -125,15 +125,18 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const SceneObject& obj = scene.objects[i];
     if (obj.medium < 0) continue;
-    if (optical_thickness_bound(scene, obj) <= kMaxOpticalThickness) continue;
+    // The majorant scale multiplies what tracking walks (issue 29: 10^7 on a thin medium hung).
+    const double scale = std::max(1.0, scene.settings.tracking.majorant_scale);
+    if (optical_thickness_bound(scene, obj) * scale <= kMaxOpticalThickness) continue;
     const double tau = null_thickness_bound(scene, i);
     if (!(tau <= kMaxOpticalThickness))
       throw SceneError(fmt::format(
           "{}: {}/medium: medium \"{}\" may cost {:.3g} null collisions along a ray across the "
-          "object; at most {:.0e} are supported (a heterogeneous or chromatic medium this dense "
-          "would render as if hung)",
+          "object; at most {:.0e} are supported ({})",
           desc.source, object_descs[i]->json_path, desc.media[obj.medium].name, tau,
-          kMaxOpticalThickness));
+          kMaxOpticalThickness,
+          scale > 1 ? fmt::format("integrator.majorant.scale {:g} multiplies the majorants", scale)
+                    : "a heterogeneous or chromatic medium this dense would render as if hung"));
   }
   return scene;
 }
