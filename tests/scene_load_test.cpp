@@ -193,11 +193,11 @@ std::vector<BadScene> bad_scenes() {
       {"negative radius",
        with_shape(R"({"type": "sphere", "radius": -1})"),
        {},
-       "scene.json: /shapes/ball/radius: must be > 0"},
+       "scene.json: /shapes/ball/radius: must be in (0, 1e+100]"},
       {"zero ellipsoid radius",
        with_shape(R"({"type": "ellipsoid", "radii": [1, 2, 0]})"),
        {},
-       "scene.json: /shapes/ball/radii/2: must be > 0"},
+       "scene.json: /shapes/ball/radii/2: must be in (0, 1e+100]"},
       {"unknown primitive type",
        with_shape(R"({"type": "sphre", "radius": 1})"),
        {},
@@ -778,6 +778,25 @@ TEST(SceneLoad, DocumentsNestedTooDeeplyAreRefusedWhileParsing) {
   } catch (const SceneError& e) {
     EXPECT_NE(std::string(e.what()).find("nest deeper than 1024 levels"), std::string::npos);
   }
+}
+
+// Issue 29: overflow was misdiagnosed. A camera 1e200 away was "parallel to the default up", a
+// sphere centred there "unbounded", 400 scalings by 10 "determinant -nan". Coordinates and
+// lengths beyond 1e100 are refused with their range; a transform that leaves a double's range
+// says so.
+TEST(SceneLoad, HugeCoordinatesAndTransformsAreRefusedWithTheirRange) {
+  EXPECT_EQ(load_error(R"({"camera": {"from": [0, 0, 1e200], "to": [0, 0, 0]}})"),
+            "scene.json: /camera/from/2: must be in [-1e+100, 1e+100]");
+  EXPECT_EQ(load_error(with_object(
+                R"({"shape": {"type": "sphere", "center": [1e200, 0, 0], "radius": 1}})")),
+            "scene.json: /objects/0/shape/center/0: must be in [-1e+100, 1e+100]");
+  std::string steps = "[";
+  for (int i = 0; i < 400; ++i) steps += R"({"scale": 10}, )";
+  for (int i = 0; i < 400; ++i) steps += std::string(R"({"scale": 0.1})") + (i < 399 ? ", " : "]");
+  EXPECT_EQ(load_error(with_object(R"({"shape": {"type": "sphere", "radius": 1, "transform": )" +
+                                   steps + "}}")),
+            "scene.json: /objects/0/shape/transform: the steps compose to a transform beyond a "
+            "double's range (their scales multiply)");
 }
 
 // Issue 29: numbers past a double had no JSON path ("number overflow parsing '1e400'") or became

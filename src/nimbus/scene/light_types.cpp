@@ -1,6 +1,7 @@
 #include "nimbus/scene/light_types.h"
 
 #include "nimbus/scene/colour_reader.h"
+#include "nimbus/scene/load.h"
 
 namespace nimbus {
 namespace {
@@ -26,14 +27,14 @@ void read_directional(JsonObject& o, Light& l) {
 
 void read_point(JsonObject& o, Light& l) {
   l.type = Light::Type::Point;
-  l.position = o.required("position").vec3();
+  l.position = o.required("position").vec3(kCoordinate);
   l.emission = emission(o, "intensity");
 }
 
 void read_sphere(JsonObject& o, Light& l) {
   l.type = Light::Type::Sphere;
-  l.center = o.required("center").vec3();
-  l.radius = o.required("radius").number(above(0));
+  l.center = o.required("center").vec3(kCoordinate);
+  l.radius = o.required("radius").number(kLength);
   l.emission = emission(o, "radiance");
 }
 

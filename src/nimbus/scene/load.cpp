@@ -99,7 +99,7 @@ Mat4 read_transform(const JsonValue& v) {
       step.fail(R"(expected exactly one of "translate", "rotate", "scale")");
     Mat4 s;
     if (translate) {
-      s = Mat4::translate(translate->vec3());
+      s = Mat4::translate(translate->vec3(kCoordinate));
     } else if (rotate) {
       JsonObject r(*rotate);
       const Vec3 axis = r.required("axis").direction();
@@ -119,7 +119,10 @@ Mat4 read_transform(const JsonValue& v) {
     m = s * m;  // steps apply in the listed order
   }
   const double det = determinant(m);
-  if (!(std::abs(det) > kMinDeterminant) || !std::isfinite(det))
+  // Scale factors multiply along the steps: 400 steps of 10 leave a double's range.
+  if (!std::isfinite(det))
+    v.fail("the steps compose to a transform beyond a double's range (their scales multiply)");
+  if (!(std::abs(det) > kMinDeterminant))
     v.fail(fmt::format("degenerate transform (determinant {})", det));
   return m;
 }
@@ -176,9 +179,9 @@ class Loader {
       c.type = t->choice("camera type", {"perspective", "orthographic"}) == 0
                    ? CameraDesc::Type::Perspective
                    : CameraDesc::Type::Orthographic;
-    c.from = o.required("from").vec3();
+    c.from = o.required("from").vec3(kCoordinate);
     const JsonValue to = o.required("to");
-    c.to = to.vec3();
+    c.to = to.vec3(kCoordinate);
     const auto up = o.optional("up");
     if (up) c.up = up->direction();
     if (auto f = o.optional("fov")) c.fov = f->number(strictly_between(0, 180));
@@ -394,7 +397,7 @@ class Loader {
          "box", "freeform", "union", "intersection", "difference"});
     const auto point = [&](const char* key) {
       const auto p = o.optional(key);
-      return p ? p->vec3() : Vec3{};
+      return p ? p->vec3(kCoordinate) : Vec3{};
     };
     ShapePtr s;
     if (kind == "quadric") {
@@ -410,14 +413,14 @@ class Loader {
       s = make_shape(QuadricNode{q});
     } else if (kind == "sphere") {
       const Vec3 center = point("center");
-      s = make_shape(QuadricNode{sphere(center, o.required("radius").number(above(0)))});
+      s = make_shape(QuadricNode{sphere(center, o.required("radius").number(kLength))});
     } else if (kind == "ellipsoid") {
       const Vec3 center = point("center");
-      s = make_shape(QuadricNode{ellipsoid(center, o.required("radii").vec3(above(0)))});
+      s = make_shape(QuadricNode{ellipsoid(center, o.required("radii").vec3(kLength))});
     } else if (kind == "cylinder") {
       const Vec3 p = point("point");
       const Vec3 axis = o.required("axis").direction();
-      s = make_shape(QuadricNode{cylinder(p, axis, o.required("radius").number(above(0)))});
+      s = make_shape(QuadricNode{cylinder(p, axis, o.required("radius").number(kLength))});
     } else if (kind == "cone") {
       const Vec3 apex = point("apex");
       const Vec3 axis = o.required("axis").direction();
@@ -426,7 +429,7 @@ class Loader {
     } else if (kind == "paraboloid") {
       const Vec3 vertex = point("vertex");
       const Vec3 axis = o.required("axis").direction();
-      const double f = o.required("focal_length").number(above(0));
+      const double f = o.required("focal_length").number(kLength);
       s = make_shape(QuadricNode{paraboloid(vertex, axis, f)});
     } else if (kind == "halfspace") {
       const Vec3 p = point("point");
@@ -434,11 +437,11 @@ class Loader {
     } else if (kind == "slab") {
       const Vec3 center = point("center");
       const Vec3 normal = o.required("normal").direction();
-      s = make_shape(QuadricNode{slab(center, normal, o.required("thickness").number(above(0)))});
+      s = make_shape(QuadricNode{slab(center, normal, o.required("thickness").number(kLength))});
     } else if (kind == "box") {
-      const Vec3 lo = o.required("min").vec3();
+      const Vec3 lo = o.required("min").vec3(kCoordinate);
       const JsonValue max_value = o.required("max");
-      const Vec3 hi = max_value.vec3();
+      const Vec3 hi = max_value.vec3(kCoordinate);
       for (int i = 0; i < 3; ++i)
         if (!(hi[i] > lo[i]))
           max_value.array()[i].fail(fmt::format("must be greater than min ({})", lo[i]));

@@ -28,6 +28,13 @@ inline constexpr int kMaxJsonDepth = 4 * kMaxShapeDepth;
 // what would exhaust memory.
 inline constexpr std::uintmax_t kMaxSceneFileBytes = std::uintmax_t{64} << 20;
 
+// Points, directions and lengths (a position, a radius, a translation) lie within ±1e100: their
+// squares and products, which the quadrics and the camera compute, stay within a double
+// (issue 29: a camera 1e200 away was "parallel to up", a sphere there "unbounded").
+inline constexpr double kMaxCoordinate = 1e100;
+inline const Range kCoordinate = between(-kMaxCoordinate, kMaxCoordinate);
+inline const Range kLength = Range{0.0, kMaxCoordinate, true, false};
+
 // Reads, parses and validates a scene file; every problem is one SceneError line naming the
 // file and, inside it, the JSON path.
 SceneDesc load_scene_file(const std::string& path, const std::vector<std::string>& overrides = {});
