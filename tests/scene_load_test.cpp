@@ -473,6 +473,16 @@ TEST(SceneLoad, DenseGrayMediaCompileAndDenseChromaticOnesAreRefused) {
                        sphere + "]");
   };
   EXPECT_NO_THROW(compile_scene(load(scene("1e8"))));
+  // Issue 29: gray and homogeneous but past about 1e17 per unit, the octree's outward rounding
+  // (1e-12 of the density) is itself a null rate too costly; the refusal says why.
+  try {
+    compile_scene(load(scene("1e18")));
+    ADD_FAILURE() << "a gray medium of 1e18 compiled";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("or a gray one past about 1e17 per unit of its size"),
+              std::string::npos)
+        << e.what();
+  }
   try {
     compile_scene(load(scene("[1e8, 1e8, 1]")));
     ADD_FAILURE() << "a chromatic medium of 1e8 compiled";

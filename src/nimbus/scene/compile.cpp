@@ -136,7 +136,8 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
           desc.source, object_descs[i]->json_path, desc.media[obj.medium].name, tau,
           kMaxOpticalThickness,
           scale > 1 ? fmt::format("integrator.majorant.scale {:g} multiplies the majorants", scale)
-                    : "a heterogeneous or chromatic medium this dense would render as if hung"));
+                    : "a heterogeneous or chromatic medium this dense, or a gray one past "
+                      "about 1e17 per unit of its size, would render as if hung"));
   }
   return scene;
 }
