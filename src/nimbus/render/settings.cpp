@@ -12,38 +12,32 @@ namespace {
 
 using Kind = SettingType::Kind;
 
-// `field` is a generic lambda returning a reference to the member, const or not.
-template <class Field>
-Setting integer(std::string_view key, Range range, std::string_view doc, Field field) {
+// A setting held as a T and written in the file as a JSON number or boolean. `field` is a
+// generic lambda returning a reference to the member, const or not.
+template <class T, class Field>
+Setting plain(std::string_view key, Kind kind, Range range, std::string_view doc, Field field) {
   return {key,
-          {Kind::Integer, range, {}, {}},
+          {kind, range, {}, {}},
           doc,
           [field](const RenderSettings& s) { return nlohmann::json(field(s)); },
-          [field](RenderSettings& s, const nlohmann::json& v) { field(s) = v.get<int>(); },
+          [field](RenderSettings& s, const nlohmann::json& v) { field(s) = v.get<T>(); },
           {},
           {}};
+}
+
+template <class Field>
+Setting integer(std::string_view key, Range range, std::string_view doc, Field field) {
+  return plain<int>(key, Kind::Integer, range, doc, field);
 }
 
 template <class Field>
 Setting number(std::string_view key, Range range, std::string_view doc, Field field) {
-  return {key,
-          {Kind::Number, range, {}, {}},
-          doc,
-          [field](const RenderSettings& s) { return nlohmann::json(field(s)); },
-          [field](RenderSettings& s, const nlohmann::json& v) { field(s) = v.get<double>(); },
-          {},
-          {}};
+  return plain<double>(key, Kind::Number, range, doc, field);
 }
 
 template <class Field>
 Setting boolean(std::string_view key, std::string_view doc, Field field) {
-  return {key,
-          {Kind::Boolean, {}, {}, {}},
-          doc,
-          [field](const RenderSettings& s) { return nlohmann::json(field(s)); },
-          [field](RenderSettings& s, const nlohmann::json& v) { field(s) = v.get<bool>(); },
-          {},
-          {}};
+  return plain<bool>(key, Kind::Boolean, {}, doc, field);
 }
 
 // A named choice, its names from setting_names.h.
@@ -68,6 +62,11 @@ Setting choice(std::string_view key, std::string_view noun,
 }
 
 std::vector<Setting> make_settings() {
+  Setting seed = plain<uint64_t>(
+      "integrator.seed", Kind::Unsigned, {},
+      "seed of every random stream: one stream per seed, pixel and sample index",
+      [](auto& s) -> auto& { return s.seed; });
+  seed.type_text = "integer in [0, 2⁶⁴ − 1]";
   std::vector<Setting> all = {
       integer(
           "film.width", between(1, 16384), "image width in pixels",
@@ -78,13 +77,7 @@ std::vector<Setting> make_settings() {
       integer(
           "integrator.spp", at_least(1), "samples per pixel",
           [](auto& s) -> auto& { return s.spp; }),
-      {"integrator.seed",
-       {Kind::Unsigned, {}, {}, {}},
-       "seed of every random stream: one stream per seed, pixel and sample index",
-       [](const RenderSettings& s) { return nlohmann::json(s.seed); },
-       [](RenderSettings& s, const nlohmann::json& v) { s.seed = v.get<uint64_t>(); },
-       {},
-       "integer in [0, 2⁶⁴ − 1]"},
+      seed,
       integer(
           "integrator.max_depth", at_least(1),
           "most scattering or reflection events along one path",
