@@ -189,6 +189,47 @@ TEST(FirstHit, FastPathsAgreeWithTheGeneralPath) {
   }
 }
 
+// Issue 29: the unit sphere given with coefficients of 1e308 (or 1e-300) disappeared: F along a
+// ray overflowed. A quadric is defined up to a positive factor; where only F's sign matters
+// (FUse::Sign) it is normalised, and the hits are those of the unit sphere, also inside a CSG
+// node and under a transform: bit for bit for a power-of-two factor, to rounding for another.
+// Where F's value matters it is kept as given.
+TEST(FirstHit, QuadricCoefficientsOfAnyMagnitude) {
+  const auto unit = [](double s) {
+    return Quadric{{-s, -s, -s, 0, 0, 0, 0, 0, 0, s}};
+  };
+  const ShapePtr box = make_shape(
+      CsgNode{CsgOp::Intersection, {test::leaf(halfspace({0, 0, 0.5}, {0, 0, 1})),
+                                    test::leaf(halfspace({0, 0, -2}, {0, 0, -1}))}});
+  for (const Mat4& m : {Mat4::identity(), Mat4::translate({0.25, 0, 0}) * Mat4::scale({2, 1, 1})}) {
+    const auto shapes = [&](double s) {
+      return std::vector<ShapePtr>{
+          test::leaf(unit(s), m),
+          make_shape(CsgNode{CsgOp::Intersection, {test::leaf(unit(s), m), box}})};
+    };
+    for (size_t k = 0; k < 2; ++k) {
+      const Tape reference = compile(*shapes(1)[k], FUse::Sign);
+      for (double s : {0x1p1000, 0x1p-1000, 0x1p-1074, 1e308, 1e-300}) {
+        const bool exact = std::ilogb(s) == std::log2(s);
+        const Tape tape = compile(*shapes(s)[k], FUse::Sign);
+        for (int i = 0; i < 64; ++i) {
+          const Ray ray{{-0.6 + 0.02 * i, 0.1, 5}, normalize(Vec3{0.01 * i, -0.02, -1})};
+          const auto expected = first_hit(reference, ray, 0, 100);
+          const auto hit = first_hit(tape, ray, 0, 100);
+          ASSERT_EQ(hit.has_value(), expected.has_value()) << s << " ray " << i;
+          if (hit && exact) {
+            EXPECT_EQ(*hit, *expected) << s << " ray " << i;
+          } else if (hit) {
+            EXPECT_NEAR(*hit, *expected, 1e-14 * *expected) << s << " ray " << i;
+          }
+        }
+      }
+    }
+  }
+  const Tape kept = compile(*test::leaf(unit(1e-300)), FUse::Value);
+  EXPECT_EQ(evaluate(kept, Vec3{0, 0, 0}), 1e-300);
+}
+
 TEST(FirstHit, SphereMatchesClosedForm) {
   const Tape tape = compile(*test::leaf(sphere({1, 2, 3}, 2)));
   const Ray ray{{1, 2, -10}, {0, 0, 2}};

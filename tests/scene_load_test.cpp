@@ -960,6 +960,24 @@ TEST_F(SceneFileTest, OnlyRegularUtf8FilesOfBoundedSizeAreRead) {
   EXPECT_EQ(file_error(binary), binary + ": not UTF-8 text (byte 9)");
   const std::string cut = write(std::string("{\"a\": \"\xc3"));
   EXPECT_EQ(file_error(cut), cut + ": not UTF-8 text (byte 7)");
+  // Strictly UTF-8 (issue 29: an overlong form was accepted and echoed raw), and no NUL byte
+  // (it read as "unexpected end of input"); text given in memory is checked alike.
+  const std::string overlong = write(std::string("{\"a\": \"\xc0\xae\"}"));
+  EXPECT_EQ(file_error(overlong), overlong + ": not UTF-8 text (byte 7)");
+  const std::string surrogate = write(std::string("{\"a\": \"\xed\xa0\x80\"}"));
+  EXPECT_EQ(file_error(surrogate), surrogate + ": not UTF-8 text (byte 7)");
+  const std::string nul = write(std::string("{\"a\": 1}\0 ", 11));
+  EXPECT_EQ(file_error(nul), nul + ": a NUL byte at byte 8 (a scene file is text)");
+  EXPECT_THROW(
+      {
+        try {
+          load_scene_text("{\"a\": \"\xc0\xae\"}", "in memory");
+        } catch (const SceneError& e) {
+          EXPECT_STREQ(e.what(), "in memory: not UTF-8 text (byte 7)");
+          throw;
+        }
+      },
+      SceneError);
   const std::string ok = write(std::string("{\"film\": {\"width\": 8}} // caf\xc3\xa9"));
   EXPECT_EQ(file_error(ok).find("UTF-8"), std::string::npos) << file_error(ok);
   const std::string big = (dir_ / "big.json").string();

@@ -1,5 +1,6 @@
 #include "nimbus/frep/quadric.h"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -25,6 +26,16 @@ Quadric from_matrix(const Mat4& A) {
 Quadric transformed(const Quadric& q, const Mat4& M) {
   const Mat4 Minv = inverse(M);
   return from_matrix(transpose(Minv) * to_matrix(q) * Minv);
+}
+
+Quadric normalised(const Quadric& q) {
+  double largest = 0;
+  for (double a : q.a) largest = std::max(largest, std::abs(a));
+  if (!(largest > 0) || !std::isfinite(largest)) return q;
+  Quadric n = q;
+  const int e = std::ilogb(largest);
+  for (double& a : n.a) a = std::ldexp(a, -e);
+  return n;
 }
 
 // The cancellation-free pair q / a, c / q with q = −(b + sign(b) √disc) / 2; when a → 0 the root

@@ -50,6 +50,11 @@ int sign_change_roots(const RayQuadratic& p, double roots[2]);
 Mat4 to_matrix(const Quadric& q);
 Quadric from_matrix(const Mat4& A);
 
+// The same surface and inside with the coefficients scaled by a power of two (exactly) so that
+// the largest magnitude lies in [1, 2): a quadric is defined up to a positive factor, and
+// coefficients near a double's limits (1e308, 1e-300) would overflow or underflow F along a ray.
+Quadric normalised(const Quadric& q);
+
 // The quadric of the transformed object: F'(x) = F(M⁻¹ x), i.e. A' = M⁻ᵀ A M⁻¹.
 // Only the coefficients change (paper §2.1). M must be invertible.
 Quadric transformed(const Quadric& q, const Mat4& M);

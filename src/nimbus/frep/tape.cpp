@@ -13,7 +13,7 @@ namespace {
 
 class Compiler {
  public:
-  explicit Compiler(Tape& tape) : tape_(tape) {}
+  Compiler(Tape& tape, FUse use) : tape_(tape), use_(use) {}
 
   // Emits code leaving the node's F in register `reg`, with registers above it as scratch.
   // `parent` is the composed object-to-world transform of the node's ancestors.
@@ -32,7 +32,11 @@ class Compiler {
 
   void emit_node(const QuadricNode& node, const Mat4& world, int reg) {
     const auto index = static_cast<std::uint32_t>(tape_.quadrics.size());
-    tape_.quadrics.push_back(transformed(node.q, world));
+    // Only the sign matters here: normalise before the transform (its products must not
+    // overflow) and after it (it may scale the coefficients far from 1).
+    const bool sign_only = use_ == FUse::Sign && summed_depth_ == 0;
+    tape_.quadrics.push_back(sign_only ? normalised(transformed(normalised(node.q), world))
+                                       : transformed(node.q, world));
     // Where a quadric is <= 0, [-inf, 0] encloses it. That keeps what unions and intersections
     // need (the sign of the upper bound) but not what a sum needs (how far below 0 a free form's
     // base lies, which perturbations must overcome) nor what negation turns into the upper bound.
@@ -82,6 +86,7 @@ class Compiler {
   void push(const Instr& in) { tape_.code.push_back(in); }
 
   Tape& tape_;
+  FUse use_;
   bool negated_ = false;  // the node being emitted is negated (an odd number of times)
   int summed_depth_ = 0;  // how many free forms' sums (base or perturbation) the node lies in
 };
@@ -166,12 +171,12 @@ std::size_t count_quadrics(const ShapeDesc& shape, std::size_t cap) {
   return count_quadrics(shape, cap, memo);
 }
 
-Tape compile(const ShapeDesc& shape) {
+Tape compile(const ShapeDesc& shape, FUse use) {
   if (count_quadrics(shape) > kMaxTapeQuadrics)
     throw std::invalid_argument("compile: more than " + std::to_string(kMaxTapeQuadrics) +
                                 " quadrics in one shape");
   Tape tape;
-  Compiler(tape).emit(shape, Mat4::identity(), 0);
+  Compiler(tape, use).emit(shape, Mat4::identity(), 0);
   tape.only_cubed = only_cubed(tape);
   tape.cull_box.assign(tape.quadrics.size(), Box::everything());
   for (size_t i = 0; i < tape.quadrics.size(); ++i)

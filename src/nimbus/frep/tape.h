@@ -84,10 +84,17 @@ constexpr std::size_t kMaxTapeQuadrics = 20000;
 // the count stops just above `cap` (so any shape is counted quickly).
 std::size_t count_quadrics(const ShapeDesc& shape, std::size_t cap = kMaxTapeQuadrics);
 
+// Whether the caller reads F's value (a density that grows with F) or only its sign (the
+// surface). With Sign, a quadric whose value feeds only unions, intersections and differences is
+// normalised (quadric.h): the same surface, but coefficients of any finite magnitude are
+// intersected without overflow. A free form's sum reads F's value (a perturbation of weight w
+// adds to F), so the quadrics in one are kept as given.
+enum class FUse { Value, Sign };
+
 // Throws std::invalid_argument on a null shape, an empty CSG node, nesting deeper than
 // kMaxRegisters or more than kMaxTapeQuadrics quadrics; otherwise assumes a valid tree (the
 // scene loader checks it).
-Tape compile(const ShapeDesc& shape);
+Tape compile(const ShapeDesc& shape, FUse use = FUse::Value);
 
 double evaluate(const Tape& tape, const Vec3& p);     // F(p), > 0 inside
 Vec3 gradient(const Tape& tape, const Vec3& p);       // ∇F(p), forward mode; points inward

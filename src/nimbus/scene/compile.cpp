@@ -100,7 +100,9 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
   std::vector<const ObjectDesc*> object_descs;  // of each compiled object, for messages
   for (const ObjectDesc& od : desc.objects) {
     SceneObject obj;
-    obj.tape = compile(*od.shape);
+    const int medium = compiled_medium(od);
+    const bool reads_F = medium >= 0 && scene.media[medium].density->uses_F();
+    obj.tape = compile(*od.shape, reads_F ? FUse::Value : FUse::Sign);
     const Bounds b = compute_bounds(obj.tape);
     if (!b.bounded)
       throw SceneError(fmt::format(
@@ -109,7 +111,7 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
     if (b.box.empty()) continue;  // nothing is inside: the object cannot be seen
     obj.bounds = b.box;
     obj.surface = compile_surface(od.surface);
-    obj.medium = compiled_medium(od);
+    obj.medium = medium;
     if (obj.surface.type == Surface::Type::None && obj.medium >= 0) {
       if (++field_objects > kMaxMediaAtPoint)
         throw SceneError(

@@ -103,6 +103,15 @@ size_t utf8_sequence_at(std::string_view text, size_t i) {
 
 }  // namespace
 
+size_t invalid_utf8_at(std::string_view text) {
+  for (size_t i = 0; i < text.size();) {
+    const size_t n = utf8_sequence_at(text, i);
+    if (n == 0) return i;
+    i += n;
+  }
+  return std::string_view::npos;
+}
+
 std::string printable_line(std::string_view text) {
   std::string out;
   for (size_t i = 0; i < text.size();) {

@@ -27,6 +27,10 @@ namespace nimbus {
 inline constexpr size_t kMaxMessageBytes = 1000;
 std::string printable_line(std::string_view text);
 
+// The first byte offset at which `text` is not well-formed UTF-8 (a stray continuation byte, an
+// overlong form, a surrogate, past U+10FFFF, a sequence cut short), or npos.
+size_t invalid_utf8_at(std::string_view text);
+
 // A scene error; the message is the complete one-line report (printable_line).
 struct SceneError : std::runtime_error {
   explicit SceneError(std::string_view message) : std::runtime_error(printable_line(message)) {}

@@ -492,24 +492,6 @@ class Loader {
   std::map<std::string, int> media_index_;
 };
 
-// The first byte offset at which `text` is not well-formed UTF-8, or npos.
-size_t invalid_utf8_at(std::string_view text) {
-  size_t i = 0;
-  while (i < text.size()) {
-    const auto b = static_cast<unsigned char>(text[i]);
-    const int n = b < 0x80           ? 0
-                  : (b >> 5) == 0x6  ? 1
-                  : (b >> 4) == 0xe  ? 2
-                  : (b >> 3) == 0x1e ? 3
-                                     : -1;
-    if (n < 0 || i + n >= text.size() + (n == 0 ? 1 : 0)) return i;
-    for (int k = 1; k <= n; ++k)
-      if ((static_cast<unsigned char>(text[i + k]) >> 6) != 0x2) return i;
-    i += n + 1;
-  }
-  return std::string_view::npos;
-}
-
 // The scene file's text: a regular file of at most kMaxSceneFileBytes, in UTF-8. Anything else
 // (a directory, a FIFO that would block, /dev/zero that never ends, a binary file) is one line.
 std::string read_file(const std::string& path) {
@@ -537,10 +519,7 @@ std::string read_file(const std::string& path) {
   text << in.rdbuf();
   if (in.bad())
     throw SceneError(fmt::format("{}: cannot read file ({})", path, std::strerror(errno)));
-  std::string s = text.str();
-  if (const size_t at = invalid_utf8_at(s); at != std::string_view::npos)
-    throw SceneError(fmt::format("{}: not UTF-8 text (byte {})", path, at));
-  return s;
+  return text.str();
 }
 
 }  // namespace
@@ -735,7 +714,13 @@ SceneDesc load_scene_json(nlohmann::json j, const std::string& source,
 
 namespace {
 
+// The text must be UTF-8 (strictly: an overlong form or a surrogate is not) without NUL bytes,
+// which the JSON parser would take for the end of the input (issue 29).
 nlohmann::json parse_scene_text(const std::string& text, const std::string& source) {
+  if (const size_t at = invalid_utf8_at(text); at != std::string_view::npos)
+    throw SceneError(fmt::format("{}: not UTF-8 text (byte {})", source, at));
+  if (const size_t at = text.find('\0'); at != std::string::npos)
+    throw SceneError(fmt::format("{}: a NUL byte at byte {} (a scene file is text)", source, at));
   nlohmann::json j;
   DuplicateKeys keys(source);
   try {
