@@ -234,9 +234,9 @@ int finish_render(const RenderArgs& args, const nimbus::RenderJob& job,
   }
   if (const uint64_t n = r.counters.rejected_samples; n > 0)
     std::fprintf(stderr,
-                 "nimbus: warning: %llu samples were NaN or infinite and counted as 0 "
-                 "(counters.rejected_samples in --stats)\n",
-                 static_cast<unsigned long long>(n));
+                 "nimbus: warning: %llu samples were NaN or of magnitude %.3g or more and "
+                 "counted as 0 (counters.rejected_samples in --stats)\n",
+                 static_cast<unsigned long long>(n), r.film.max_value());
   if (const int failed = write_outputs(args, outputs, r.film, job.stats(r)); failed != 0)
     return failed;
   const RenderSettings& s = job.scene().settings;

@@ -54,6 +54,7 @@ Scene small_scene(int spp) {
 void expect_same_bits(const Film& a, const Film& b) {
   ASSERT_EQ(a.width, b.width);
   ASSERT_EQ(a.height, b.height);
+  ASSERT_EQ(a.exponent, b.exponent);
   for (int p = 0; p < a.pixels(); ++p) {
     ASSERT_EQ(a.samples[p], b.samples[p]) << p;
     ASSERT_TRUE(a.sum[p] == b.sum[p]) << p;
@@ -195,6 +196,56 @@ TEST(Film, RefusesValuesThatWouldPoisonThePixel) {
   EXPECT_EQ(film.samples[1], 0u);
 }
 
+// Issue 29: the film's range was absolute, so an environment of radiance 1e19 rendered black
+// (every sample "NaN or infinite") and one of 1e-20 rendered 0. The exponent follows the
+// brightest emitter.
+TEST(Film, TheExponentFollowsTheBrightestEmitter) {
+  EXPECT_EQ(film_exponent(0), 0);
+  EXPECT_EQ(film_exponent(1), 0);
+  EXPECT_EQ(film_exponent(0x1p-44), 0);
+  EXPECT_EQ(film_exponent(0x1.fp22), 0);
+  EXPECT_EQ(film_exponent(0x1p23), 1);
+  EXPECT_EQ(film_exponent(1e19), 63 - 22);
+  EXPECT_EQ(film_exponent(1e-20), -67 - 22);
+  Scene scene = small_scene(1);
+  // The sun's irradiance 3, or its D65-shaped curve's largest bin for spectral mode.
+  EXPECT_GE(brightest_emission(scene), 3.0);
+  EXPECT_LT(brightest_emission(scene), 4.0);
+  EXPECT_EQ(scene.film_exponent, 0);
+  scene.lights[1].emission = Rgb({0.1, 5e29, 0.1});
+  EXPECT_EQ(brightest_emission(scene), 5e29);
+}
+
+// The same scene lit 2^64 (1.8e19), 2^-67 (6.8e-21) or 2^99 (6.3e29) times as brightly renders
+// the same image times that factor (a power of two, so every path makes the same choices):
+// equal to the film's rounding, with no sample refused.
+TEST(Film, ScenesLitAtAnyScaleRenderAlike) {
+  const Scene reference_scene = small_scene(2);
+  const Film reference = render(reference_scene).film;
+  for (const double k : {0x1p64, 0x1p-67, 0x1p99}) {
+    Scene scene = small_scene(2);
+    for (Light& light : scene.lights) light.emission = Rgb(light.emission.rgb * k);
+    test::finish_media(scene);
+    EXPECT_NE(scene.film_exponent, 0) << k;
+    const RenderResult r = render(scene);
+    EXPECT_EQ(r.counters.rejected_samples, 0u) << k;
+    EXPECT_EQ(r.film.exponent, scene.film_exponent);
+    for (int p = 0; p < r.film.pixels(); ++p)
+      for (int c = 0; c < 3; ++c)
+        ASSERT_NEAR(r.film.mean(p)[c] / k, reference.mean(p)[c],
+                    1e-12 * std::abs(reference.mean(p)[c]) + 0x1p-60)
+            << k << " pixel " << p << " channel " << c;
+    // A film of another exponent is not this scene's.
+    Film other(scene.settings.width, scene.settings.height);
+    EXPECT_THROW(render_into(scene, other), std::invalid_argument);
+    // Saved and loaded, the exponent comes back.
+    const std::string path =
+        (std::filesystem::temp_directory_path() / "nimbus_film_exponent.film").string();
+    save_film(r.film, path);
+    expect_same_bits(r.film, load_film(path));
+  }
+}
+
 TEST(MemoryEstimate, CountsTheFilmAndParsesSizes) {
   const MemoryEstimate e = estimate_render_memory(100, 50, 2, 3, 4);
   EXPECT_EQ(e.film, 100.0 * 50 * (3 * 16 + 3 * sizeof(double) + sizeof(uint32_t)));
@@ -250,7 +301,7 @@ TEST(Film, RoundTripsThroughAFile) {
     const uint32_t version = 99;
     f.write(reinterpret_cast<const char*>(&version), sizeof version);
   }
-  EXPECT_EQ(message(bad), bad + ": film file version 99, this nimbus reads 2");
+  EXPECT_EQ(message(bad), bad + ": film file version 99, this nimbus reads 3");
   std::filesystem::remove_all(dir);
 }
 

@@ -8,6 +8,7 @@
 #include "frep_gallery.h"
 #include "nimbus/frep/intersect.h"
 #include "nimbus/frep/tape.h"
+#include "nimbus/scene/load.h"
 
 namespace nimbus {
 namespace {
@@ -195,12 +196,10 @@ TEST(FirstHit, FastPathsAgreeWithTheGeneralPath) {
 // node and under a transform: bit for bit for a power-of-two factor, to rounding for another.
 // Where F's value matters it is kept as given.
 TEST(FirstHit, QuadricCoefficientsOfAnyMagnitude) {
-  const auto unit = [](double s) {
-    return Quadric{{-s, -s, -s, 0, 0, 0, 0, 0, 0, s}};
-  };
-  const ShapePtr box = make_shape(
-      CsgNode{CsgOp::Intersection, {test::leaf(halfspace({0, 0, 0.5}, {0, 0, 1})),
-                                    test::leaf(halfspace({0, 0, -2}, {0, 0, -1}))}});
+  const auto unit = [](double s) { return Quadric{{-s, -s, -s, 0, 0, 0, 0, 0, 0, s}}; };
+  const ShapePtr box = make_shape(CsgNode{CsgOp::Intersection,
+                                          {test::leaf(halfspace({0, 0, 0.5}, {0, 0, 1})),
+                                           test::leaf(halfspace({0, 0, -2}, {0, 0, -1}))}});
   for (const Mat4& m : {Mat4::identity(), Mat4::translate({0.25, 0, 0}) * Mat4::scale({2, 1, 1})}) {
     const auto shapes = [&](double s) {
       return std::vector<ShapePtr>{
@@ -228,6 +227,35 @@ TEST(FirstHit, QuadricCoefficientsOfAnyMagnitude) {
   }
   const Tape kept = compile(*test::leaf(unit(1e-300)), FUse::Value);
   EXPECT_EQ(evaluate(kept, Vec3{0, 0, 0}), 1e-300);
+}
+
+// Issue 29: free-form weights from about 1e50 speckled the surface (the flat path's polynomial
+// lost the base next to the perturbation: wrong hits from 1e30 on). Scene files take weights
+// within ±1e15 (kMaxPerturbationWeight); at that limit both paths agree with brute force.
+TEST(FirstHit, FreeFormsAtTheLargestWeightAgreeWithBruteForce) {
+  const double w = kMaxPerturbationWeight;
+  const ShapePtr carve = make_shape(CsgNode{
+      CsgOp::Intersection,
+      {test::leaf(sphere({0, 0.9, 0}, 0.3)), test::leaf(halfspace({0, 0.8, 0}, {0, 1, 0}))}});
+  for (const bool flat : {true, false}) {
+    FreeFormNode ff{test::leaf(sphere({0, 0, 0}, 1.0)), {}};
+    ff.perturbations.push_back({test::leaf(sphere({0.9, 0, 0}, 0.3)), w});
+    ff.perturbations.push_back({flat ? test::leaf(sphere({0, 0.9, 0}, 0.3)) : carve, -w});
+    const Tape tape = compile(*make_shape(std::move(ff)));
+    ASSERT_EQ(tape.kind, flat ? TapeKind::FlatFreeForm : TapeKind::General);
+    const GalleryShape g{"weighty", nullptr, {0, 0, 0}, 1.6};
+    Rng rng(7);
+    for (int i = 0; i < 2000; ++i) {
+      const Vec3 o = 4.0 * random_unit(rng);
+      const Ray ray{o, normalize(random_in_cube(rng, 1.0) - o)};
+      const auto expected = reference_hit(tape, g, ray, 0, 100);
+      const auto hit = first_hit(tape, ray, 0, 100);
+      ASSERT_EQ(hit.has_value(), expected.has_value()) << flat << " ray " << i;
+      if (hit) {
+        EXPECT_NEAR(*hit, *expected, 1e-6) << flat << " ray " << i;
+      }
+    }
+  }
 }
 
 TEST(FirstHit, SphereMatchesClosedForm) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "nimbus/math/rng.h"
 
@@ -26,6 +27,26 @@ TEST(Noise, BoundHoldsOnAMillionPoints) {
     EXPECT_LE(max_abs, kNoiseBound) << seed;
     EXPECT_GT(max_abs, 0.6 * kNoiseBound) << seed;
   }
+}
+
+// Issue 29: a cloud of frequency 1e308 made NaN samples, and past 2^63 the lattice cell had no
+// int64 (undefined behaviour). The lattice repeats every 256 cells, and far coordinates are
+// reduced into one period exactly: the noise there is the noise of the reduced point, finite
+// and bounded, and a point that is not finite reads the origin's cell.
+TEST(Noise, FarCoordinatesAreReducedIntoOnePeriod) {
+  const Noise n = make_noise(3);
+  Rng rng(5, 1);
+  for (int i = 0; i < 1000; ++i) {
+    const Vec3 far = random_point(rng, 1e200);
+    const Vec3 reduced{std::fmod(far.x, 256.0), std::fmod(far.y, 256.0), std::fmod(far.z, 256.0)};
+    EXPECT_EQ(noise(n, far), noise(n, reduced)) << i;
+    EXPECT_LE(std::abs(noise(n, far)), kNoiseBound);
+  }
+  // Below 2^52 nothing changes: one period on, the same value.
+  const Vec3 p{0x1p51 + 0.25, -17.5, 3.75};
+  EXPECT_EQ(noise(n, p), noise(n, p + Vec3{256, 0, 0}));
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_TRUE(std::isfinite(noise(n, {inf, -inf, 1.5})));
 }
 
 TEST(Noise, FadeWeightsSatisfyTheBoundLemma) {

@@ -242,6 +242,9 @@ TEST(TemperatureGridErrors, BadInputIsOneLineNamingTheJsonPathAndTheFile) {
   test::write_vec3s_vdb(dir.file("vectors.vdb"), "temperature", {0, 0, 0}, {1, 0, 0});
   test::write_level_set_sphere_vdb(dir.file("levelset.vdb"), "temperature", 1.0, 0.1);
   std::ofstream(dir.file("text.vdb")) << "hot air\n";
+  // Issue 29: a grid at 3e38 K made NaN samples; it emits about 1e40, beyond what a scene may.
+  test::write_vdb(dir.file("hot.vdb"), {grid_of("temperature", {0, 0, 0}, {1, 1, 1},
+                                                [](int, int, int) { return 3e38; })});
 
   struct Case {
     std::string emission, expected;
@@ -264,7 +267,15 @@ TEST(TemperatureGridErrors, BadInputIsOneLineNamingTheJsonPathAndTheFile) {
       {R"({"file": "levelset.vdb"})",
        at + ": " + dir.file("levelset.vdb") +
            R"(: grid "temperature" is a level set (signed distances), not a temperature; convert it to a fog volume first (OpenVDB's tools::sdfToFogVolume))"},
-      {R"({"file": "smoke.vdb", "grid": "flames", "scale": -1})", at + "/scale: must be >= 0"},
+      {R"({"file": "smoke.vdb", "grid": "flames", "scale": -1})",
+       at + "/scale: must be in [0, 1e+30]"},
+      {R"({"file": "smoke.vdb", "grid": "flames", "scale": 1e31})",
+       at + "/scale: must be in [0, 1e+30]"},
+      {R"({"file": "hot.vdb"})",
+       at + ": " + dir.file("hot.vdb") +
+           R"(: grid "temperature" reaches 3e+38 K, where the emitted radiance (times scale 1) is )" +
+           fmt::format("{:.3g}", std::max(planck_rgb(3e38f).max(), planck_spectrum(3e38f).scale)) +
+           "; emitted light may be at most 1e+30"},
       {R"({"file": ""})", at + "/file: must name a file"},
       {R"({"file": "smoke.vdb", "grid": ""})", at + "/grid: must name a grid"},
       {R"({"grid": "flames"})", at + "/file: required key is missing"},

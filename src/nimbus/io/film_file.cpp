@@ -14,7 +14,8 @@ namespace nimbus {
 namespace {
 
 constexpr char kFilmMagic[8] = {'N', 'I', 'M', 'F', 'I', 'L', 'M', '\0'};
-constexpr uint32_t kFilmVersion = 2;  // 2: exact sums (128-bit fixed point)
+// 2: exact sums (128-bit fixed point); 3: the film's exponent (version 2 files read as 0).
+constexpr uint32_t kFilmVersion = 3;
 static_assert(std::endian::native == std::endian::little, "film files are little endian");
 
 }  // namespace
@@ -25,6 +26,7 @@ void write_film(std::ostream& out, const Film& film) {
   put(kFilmVersion);
   put(static_cast<int32_t>(film.width));
   put(static_cast<int32_t>(film.height));
+  put(static_cast<int32_t>(film.exponent));
   for (int p = 0; p < film.pixels(); ++p) {
     put(film.samples[p]);
     for (int c = 0; c < 3; ++c) put(film.sum[p].c[c]);
@@ -43,7 +45,7 @@ Film read_film(std::istream& in, const std::string& name) {
     throw std::runtime_error(name + ": not a nimbus film file");
   uint32_t version = 0;
   get(version);
-  if (version != kFilmVersion)
+  if (version != kFilmVersion && version != 2)
     throw std::runtime_error(
         fmt::format("{}: film file version {}, this nimbus reads {}", name, version, kFilmVersion));
   int32_t w = 0, h = 0;
@@ -51,7 +53,12 @@ Film read_film(std::istream& in, const std::string& name) {
   get(h);
   if (w <= 0 || h <= 0 || w > 1 << 16 || h > 1 << 16)
     throw std::runtime_error(fmt::format("{}: a film of {}x{} pixels", name, w, h));
-  Film film(w, h);
+  int32_t exponent = 0;
+  if (version >= 3) get(exponent);
+  // film_exponent of any finite brightness lies well within this.
+  if (exponent < -1200 || exponent > 1100)
+    throw std::runtime_error(fmt::format("{}: a film of exponent {}", name, exponent));
+  Film film(w, h, exponent);
   for (int p = 0; p < film.pixels(); ++p) {
     get(film.samples[p]);
     for (int c = 0; c < 3; ++c) get(film.sum[p].c[c]);

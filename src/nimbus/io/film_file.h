@@ -10,8 +10,8 @@
 namespace nimbus {
 
 // Saves the film to a file, atomically (io/atomic_file.h): a versioned little-endian binary of
-// the size, then per pixel the count, the three exact sums (128-bit fixed point, 2^-64 units) and
-// the three sums of squares (doubles).
+// the size and the exponent, then per pixel the count, the three exact sums (128-bit fixed point,
+// in units of 2^(exponent - 64)) and the three sums of squares (doubles).
 void save_film(const Film& film, const std::string& path);
 
 // Loads a film saved by save_film; std::runtime_error("PATH: problem") if the file is missing,

@@ -118,6 +118,12 @@ void RenderJob::check_compiled() const {
         "--resume {}: the checkpoint's majorant octrees differ from this render's (another "
         "nimbus build?)",
         file));
+  if (resumed_->film.exponent != scene_.film_exponent)
+    throw JobError(fmt::format(
+        "--resume {}: the checkpoint's film sums in units of 2^{}, this render's in 2^{} (another "
+        "nimbus build?)",
+        file, resumed_->film.exponent - kExactSumFractionBits,
+        scene_.film_exponent - kExactSumFractionBits));
 }
 
 JobOutcome RenderJob::run(JobChannel* channel) {
@@ -146,7 +152,7 @@ JobOutcome RenderJob::run_shared(JobChannel* channel) {
   SharedRenderSettings s;
   s.spp = scene_.settings.spp;
   s.threads = options_.threads;
-  s.start = resumed_ ? resumed_->film : Film(scene_.settings.width, scene_.settings.height);
+  s.start = resumed_ ? resumed_->film : make_film(scene_);
   const uint64_t held_at_start = samples_held(s.start);
   // Why the last checkpoint could not be saved; empty: it was, or none was due.
   auto failure = std::make_shared<std::string>();

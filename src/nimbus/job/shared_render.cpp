@@ -151,7 +151,7 @@ SharedRenderResult lead_shared_render(const Scene& scene, JobChannel* channel,
   std::exception_ptr local_failure;
   std::thread local([&] {
     try {
-      Film scratch(scene.settings.width, H);
+      Film scratch(scene.settings.width, H, scene.film_exponent);
       while (const std::optional<WorkUnit> u = queue.wait_next()) {
         const UnitResult r = render_unit(scene, scratch, *u, s.threads, stop);
         if (r.stats.cancelled)
@@ -188,7 +188,7 @@ SharedRenderResult lead_shared_render(const Scene& scene, JobChannel* channel,
 
 void work_on_shared_render(const Scene& scene, JobChannel& channel, int threads,
                            const std::function<bool()>& stop) {
-  Film scratch(scene.settings.width, scene.settings.height);
+  Film scratch = make_film(scene);
   Writer report;
   report.put(Report::Request);
   for (;;) {

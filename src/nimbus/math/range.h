@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include <cstdlib>
 #include <optional>
 #include <string>
 
@@ -33,11 +34,19 @@ inline bool contains(const Range& r, double x) {
 }
 
 // "in [1, 16384]", ">= 1", "> 0"; "" for no bound.
+// x in its shortest round-trip form, or past ten characters in %g where that is exact: 1e+15
+// rather than 1000000000000000; 1000000, 16384 and 0.85 as they are.
+inline std::string bound_text(double x) {
+  std::string shortest = fmt::format("{}", x), g = fmt::format("{:g}", x);
+  return shortest.size() > 10 && std::strtod(g.c_str(), nullptr) == x ? g : shortest;
+}
+
 inline std::string range_text(const Range& r) {
   if (r.lo && r.hi)
-    return fmt::format("in {}{}, {}{}", r.lo_open ? "(" : "[", *r.lo, *r.hi, r.hi_open ? ")" : "]");
-  if (r.lo) return fmt::format("{} {}", r.lo_open ? ">" : ">=", *r.lo);
-  if (r.hi) return fmt::format("{} {}", r.hi_open ? "<" : "<=", *r.hi);
+    return fmt::format("in {}{}, {}{}", r.lo_open ? "(" : "[", bound_text(*r.lo), bound_text(*r.hi),
+                       r.hi_open ? ")" : "]");
+  if (r.lo) return fmt::format("{} {}", r.lo_open ? ">" : ">=", bound_text(*r.lo));
+  if (r.hi) return fmt::format("{} {}", r.hi_open ? "<" : "<=", bound_text(*r.hi));
   return "";
 }
 

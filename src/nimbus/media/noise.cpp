@@ -41,7 +41,20 @@ Noise make_noise(uint64_t seed) {
   return n;
 }
 
-double noise(const Noise& n, const Vec3& x) {
+namespace {
+
+// The lattice repeats every 256 cells, so a coordinate far out (past 2^52, where a double has no
+// fraction left, and past 2^63, where it has no int64 for the cell) is reduced into one period
+// first (exactly: fmod is exact); a coordinate that is not finite reads the origin's cell.
+double wrapped(double v) {
+  if (std::abs(v) < 0x1p52) return v;
+  return std::isfinite(v) ? std::fmod(v, 256.0) : 0.0;
+}
+
+}  // namespace
+
+double noise(const Noise& n, const Vec3& x_in) {
+  const Vec3 x{wrapped(x_in.x), wrapped(x_in.y), wrapped(x_in.z)};
   const double fx = std::floor(x.x), fy = std::floor(x.y), fz = std::floor(x.z);
   const Vec3 t{x.x - fx, x.y - fy, x.z - fz};
   const auto ix = static_cast<uint8_t>(static_cast<int64_t>(fx) & 255);

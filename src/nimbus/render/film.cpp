@@ -17,10 +17,19 @@ Rgb Film::variance_of_mean(int pixel) const {
   return var / n;
 }
 
+int film_exponent(double brightest) {
+  if (!(brightest > 0) || !std::isfinite(brightest)) return 0;
+  const int e = std::ilogb(brightest);
+  return e >= -44 && e <= 22 ? 0 : e - 22;
+}
+
 void merge(Film& into, const Film& from) {
   if (into.width != from.width || into.height != from.height)
     throw std::invalid_argument(fmt::format("merging films of {}x{} and {}x{} pixels", into.width,
                                             into.height, from.width, from.height));
+  if (into.exponent != from.exponent)
+    throw std::invalid_argument(
+        fmt::format("merging films of exponents {} and {}", into.exponent, from.exponent));
   for (int p = 0; p < into.pixels(); ++p) {
     if (from.samples[p] == 0) continue;
     if (into.samples[p] == 0) {

@@ -20,39 +20,55 @@ namespace nimbus {
 
 struct Film {
   int width = 0, height = 0;
+  // The exact sums count in units of 2^(exponent - 64) (film_exponent): the scale of the
+  // scene's light, so that radiance of any finite magnitude is summed exactly.
+  int exponent = 0;
   std::vector<ExactRgb> sum;  // exact
   std::vector<Rgb> sum_sq;
   std::vector<uint32_t> samples;  // per pixel
 
   Film() = default;
-  Film(int w, int h)
-      : width(w), height(h), sum(size_t(w) * h), sum_sq(size_t(w) * h), samples(size_t(w) * h, 0) {}
+  Film(int w, int h, int exponent_ = 0)
+      : width(w),
+        height(h),
+        exponent(exponent_),
+        sum(size_t(w) * h),
+        sum_sq(size_t(w) * h),
+        samples(size_t(w) * h, 0) {}
   int pixels() const { return width * height; }
-  // Adds one sample. A value that is NaN or of magnitude kExactSumMaxValue (4.6e18) or more in
-  // any channel never enters the sums (one such sample would poison the pixel for good): it
-  // counts as a sample of value 0, so the pixel's sample count stays the number of samples
-  // rendered, and add returns false so that the caller can report it. Negative values are
-  // accepted: the weighted trackers are unbiased through signed weights where majorants do not
-  // bound.
+  // The largest magnitude a sample may have: 2^(62 + exponent) (4.6e18 at exponent 0).
+  double max_value() const { return std::ldexp(kExactSumMaxValue, exponent); }
+  // Adds one sample. A value that is NaN or of magnitude max_value() or more in any channel
+  // never enters the sums (one such sample would poison the pixel for good): it counts as a
+  // sample of value 0, so the pixel's sample count stays the number of samples rendered, and add
+  // returns false so that the caller can report it. Negative values are accepted: the weighted
+  // trackers are unbiased through signed weights where majorants do not bound.
   bool add(int pixel, const Rgb& value) {
     ++samples[pixel];
+    const double limit = max_value();
     for (int c = 0; c < 3; ++c)
-      if (!(std::abs(value[c]) < kExactSumMaxValue)) return false;
-    sum[pixel] += to_fixed(value);
+      if (!(std::abs(value[c]) < limit)) return false;
+    sum[pixel] += to_fixed(value, exponent);
     sum_sq[pixel] += value * value;
     return true;
   }
   // The pixel's mean sample value; 0 for a pixel without samples.
   Rgb mean(int pixel) const {
-    return samples[pixel] > 0 ? sum[pixel].value() / double(samples[pixel]) : Rgb(0.0);
+    return samples[pixel] > 0 ? sum[pixel].value(exponent) / double(samples[pixel]) : Rgb(0.0);
   }
   // Variance of the pixel's mean estimate (sample variance / samples); 0 below 2 samples.
   Rgb variance_of_mean(int pixel) const;
 };
 
-// Adds `from` into `into` (films of one size, else std::invalid_argument): a pixel `into` has no
-// samples of takes `from`'s sums as they are; otherwise the sums and counts are added (the
-// exact sums exactly).
+// The film exponent for a scene whose brightest emitter has magnitude `brightest` (0 for none):
+// 0, the exponent of every film before it existed, while 2^-44 <= brightest < 2^23; else
+// ilogb(brightest) - 22, so that samples up to 2^40 times the brightest emitter are kept and the
+// sums resolve 2^-86 of it. A scene lit at 10^19 or at 10^-20 is then summed as one lit at 1.
+int film_exponent(double brightest);
+
+// Adds `from` into `into` (films of one size and exponent, else std::invalid_argument): a pixel
+// `into` has no samples of takes `from`'s sums as they are; otherwise the sums and counts are added
+// (the exact sums exactly).
 void merge(Film& into, const Film& from);
 
 // The average of a set of pixel means and its standard error (pixels are independent).

@@ -28,6 +28,11 @@ RenderRange resolve(const Scene& scene, const Film& film, RenderRange r) {
       scene.surfaces.light_count != scene.lights.size())
     throw std::invalid_argument(
         "the scene's objects or lights changed since finish_scene: call it again");
+  if (film.exponent != scene.film_exponent)
+    throw std::invalid_argument(
+        fmt::format("the film's exponent is {}, the scene's {}: a film made for another scene's "
+                    "light (make_film)",
+                    film.exponent, scene.film_exponent));
   if (r.x1 < 0) r.x1 = W;
   if (r.y1 < 0) r.y1 = H;
   if (r.s1 < 0) r.s1 = scene.settings.spp;
@@ -59,7 +64,7 @@ RenderStats render_into(const Scene& scene, Film& film, const RenderOptions& opt
 
 RenderResult render(const Scene& scene, const RenderOptions& options) {
   RenderResult result;
-  result.film = Film(scene.settings.width, scene.settings.height);
+  result.film = make_film(scene);
   const RenderStats s = render_into(scene, result.film, options);
   result.counters = s.counters;
   result.seconds = s.seconds;

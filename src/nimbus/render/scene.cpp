@@ -1,6 +1,9 @@
 #include "nimbus/render/scene.h"
 
+#include <algorithm>
 #include <cmath>
+
+#include "nimbus/spectral/planck.h"
 
 namespace nimbus {
 
@@ -100,6 +103,41 @@ void build_majorant_octrees(Scene& scene, const BuildMonitor& monitor) {
     if (monitor.cancel && monitor.cancel()) return;
     scene.solid_octrees[solids[k]] = build_majorant_octree(scene, solids[k], part(k + 1));
   }
+}
+
+namespace {
+
+// The largest value of an emitted colour in rgb mode (a channel) or spectral mode (a bin's bound).
+double largest(const SpectralParam& p) {
+  double m = p.rgb.max();
+  for (double b : p.bin_max) m = std::max(m, b);
+  return m;
+}
+
+}  // namespace
+
+double brightest_emission(const Scene& scene) {
+  double b = 0;
+  for (const Light& light : scene.lights) b = std::max(b, largest(light.emission));
+  for (const SceneObject& obj : scene.objects) {
+    if (obj.surface.type == Surface::Type::Emissive) b = std::max(b, largest(obj.surface.radiance));
+    if (obj.medium < 0) continue;
+    const Medium& m = scene.media[obj.medium];
+    b = std::max(b, largest(m.emission));
+    if (m.emission_grid) {
+      // The hottest temperature the grid interpolates to inside the object, from the grid's own
+      // extrema (vdb_density.h); B's peak and its rgb both grow with the temperature.
+      const double kelvin = m.emission_grid->kelvin->range(obj.bounds, Interval::point(1.0)).hi;
+      if (kelvin >= kMinEmittingKelvin)
+        b = std::max(b, m.emission_grid->scale *
+                            std::max(planck_rgb(kelvin).max(), planck_spectrum(kelvin).scale));
+    }
+  }
+  return b;
+}
+
+Film make_film(const Scene& scene) {
+  return Film(scene.settings.width, scene.settings.height, scene.film_exponent);
 }
 
 void complete_spectra(Scene& scene) {

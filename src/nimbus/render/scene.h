@@ -12,6 +12,7 @@
 #include "nimbus/media/medium.h"
 #include "nimbus/media/octree.h"
 #include "nimbus/render/camera.h"
+#include "nimbus/render/film.h"
 #include "nimbus/render/light.h"
 #include "nimbus/render/material.h"
 #include "nimbus/render/surface_index.h"
@@ -89,6 +90,8 @@ struct Scene {
   std::vector<MajorantOctree> solid_octrees;
   SurfaceIndex surfaces;  // what `intersect` and `occluded` search (finish_scene builds it)
   double scale = 1;       // size of the scene's bounds, for ray offsets
+  // The exponent of its films (film.h: film_exponent of brightest_emission; finish_scene).
+  int film_exponent = 0;
 };
 
 struct SurfaceHit {
@@ -103,6 +106,15 @@ std::optional<SurfaceHit> intersect(const Scene& scene, const Ray& ray, double t
 // shadow ray aims at (`target_light`, an index into lights, or -1), which would otherwise hide
 // itself from a shadow ray whose origin was offset towards it.
 bool occluded(const Scene& scene, const Ray& ray, double t_max, int target_light = -1);
+
+// The largest emitted quantity in the scene, for the film's exponent: over its lights' emission
+// (radiance, irradiance or intensity), emissive surfaces' radiance and media's emitted radiance
+// (a temperature grid's at its hottest voxel), the largest value in any RGB channel or spectral
+// bin; 0 for a scene that emits nothing. Call after complete_spectra.
+double brightest_emission(const Scene& scene);
+
+// A fresh film for the scene: its image's size and its film exponent.
+Film make_film(const Scene& scene);
 
 // Gives every colour input of the scene its spectral curve (spectral_param.h), by role; spectral
 // mode needs them, rgb mode ignores them. Call before build_majorant_octrees.

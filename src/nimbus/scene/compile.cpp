@@ -160,6 +160,7 @@ void finish_scene(Scene& scene, const BuildMonitor& monitor) {
   if (!all.empty()) scene.scale = length(all.extent());
   scene.surfaces = build_surface_index(scene.objects, scene.lights);
   complete_spectra(scene);
+  scene.film_exponent = film_exponent(brightest_emission(scene));
   build_majorant_octrees(scene, monitor);
 }
 

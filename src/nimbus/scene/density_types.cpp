@@ -25,7 +25,7 @@ DensityMaker read_cloud(JsonObject& d) {
   CloudParams p;
   p.seed = 0;
   if (auto y = d.optional("octaves")) p.octaves = y->integer(between(1, 16));
-  if (auto y = d.optional("frequency")) p.frequency = y->number(above(0));
+  if (auto y = d.optional("frequency")) p.frequency = y->number(kLength);
   if (auto y = d.optional("amplitude")) p.amplitude = y->number(Range{0.0, 1.0, false, true});
   if (auto y = d.optional("edge")) p.edge = y->number(above(0));
   if (auto y = d.optional("seed")) p.seed = y->unsigned_integer();

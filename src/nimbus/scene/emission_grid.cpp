@@ -1,10 +1,31 @@
 #include "nimbus/scene/emission_grid.h"
 
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <filesystem>
 
 #include "nimbus/scene/load.h"
 
 namespace nimbus {
+namespace {
+
+// The grid's hottest voxel must not emit more than kMaxEmission, as any emitted light in a scene
+// file (issue 29: a grid at 3e38 K made NaN samples; its radiance, about 1e40, is beyond an
+// EXR's floats).
+void check_brightness(const TemperatureEmission& e, const VdbParams& p) {
+  const double kelvin = e.kelvin->range(Box::everything(), Interval::point(1.0)).hi;
+  if (!(kelvin >= kMinEmittingKelvin)) return;
+  const double brightest =
+      e.scale * std::max(planck_rgb(kelvin).max(), planck_spectrum(kelvin).scale);
+  if (!(brightest <= kMaxEmission))
+    throw VdbError("grid", fmt::format("{}: grid \"{}\" reaches {:.3g} K, where the emitted "
+                                       "radiance (times scale {:.3g}) is {:.3g}; emitted light "
+                                       "may be at most {:.0e}",
+                                       p.file, p.grid, kelvin, e.scale, brightest, kMaxEmission));
+}
+
+}  // namespace
 
 bool is_emission_grid(const JsonValue& v) {
   return v.json().is_object() && (v.json().contains("file") || v.json().contains("grid"));
@@ -24,7 +45,7 @@ EmissionGridMaker read_emission_grid(const JsonValue& v) {
   in.params.file = (std::filesystem::path(v.origin().folder) / path).string();
   if (grid) in.params.grid = grid->string();
   if (in.params.grid.empty()) grid->fail("must name a grid");
-  const double s = scale ? scale->number(at_least(0)) : 1.0;
+  const double s = scale ? scale->number(kEmission) : 1.0;
   if (transform) in.params.transform = read_transform(*transform);
   o.finish("for a temperature grid's emission");
   in.file_pointer = file.pointer();
@@ -32,7 +53,11 @@ EmissionGridMaker read_emission_grid(const JsonValue& v) {
   if (grid) in.grid_blame = grid->blame();
   in.object_blame = v.blame();
   return [in, s](std::vector<InputFile>& inputs) {
-    return in.read(inputs, [s](const VdbParams& p) { return make_temperature_emission(p, s); });
+    return in.read(inputs, [s](const VdbParams& p) {
+      auto e = make_temperature_emission(p, s);
+      check_brightness(*e, p);
+      return e;
+    });
   };
 }
 

@@ -9,7 +9,7 @@ namespace {
 // docs/scene-format.md, "lights": the keys of each type. Emission is radiance for lights seen
 // over a solid angle, irradiance for a directional light, intensity for a point light.
 SpectralParam emission(JsonObject& o, const char* key) {
-  return read_colour(o.required(key), SpectralRole::Illuminant, at_least(0));
+  return read_colour(o.required(key), SpectralRole::Illuminant, kEmission);
 }
 
 void read_environment(JsonObject& o, Light& l) {

@@ -48,7 +48,7 @@ SpectralParam read_colour(const JsonValue& v, SpectralRole role, const Range& ra
   if (spectrum && blackbody) blackbody->fail("give either \"spectrum\" or \"blackbody\", not both");
   if (blackbody) {
     const double kelvin = blackbody->number(between(100, 1e6));
-    const double s = scale ? scale->number(at_least(0)) : 1.0;
+    const double s = scale ? scale->number(kEmission) : 1.0;
     return from_curve(blackbody_spectrum(kelvin, s), role);
   }
   if (!spectrum)
@@ -265,7 +265,7 @@ class Loader {
       if (is_emission_grid(*x))
         m.emission_grid = read_emission_grid(*x);
       else
-        m.emission = read_colour(*x, SpectralRole::Illuminant, at_least(0));
+        m.emission = read_colour(*x, SpectralRole::Illuminant, kEmission);
     }
     if (auto x = o.optional("phase")) {
       JsonObject p(*x);
@@ -331,7 +331,7 @@ class Loader {
           break;
         case SurfaceDesc::Type::Emissive:
           obj.surface.radiance =
-              read_colour(so.required("radiance"), SpectralRole::Illuminant, at_least(0));
+              read_colour(so.required("radiance"), SpectralRole::Illuminant, kEmission);
           break;
       }
       so.finish(fmt::format("for surface type \"{}\"",
@@ -454,7 +454,8 @@ class Loader {
           JsonObject p(pv);
           Perturbation pert;
           pert.shape = shape(p.required("shape"));
-          pert.weight = p.required("weight").number();
+          pert.weight =
+              p.required("weight").number(between(-kMaxPerturbationWeight, kMaxPerturbationWeight));
           p.finish();
           node.perturbations.push_back(pert);
         }

@@ -35,6 +35,19 @@ inline constexpr double kMaxCoordinate = 1e100;
 inline const Range kCoordinate = between(-kMaxCoordinate, kMaxCoordinate);
 inline const Range kLength = Range{0.0, kMaxCoordinate, true, false};
 
+// Emitted light (a light's radiance, irradiance or intensity, a surface's or a medium's radiance,
+// a blackbody's or a temperature grid's scale) lies within [0, 1e30]: a film sums light of any
+// scale exactly (film.h, film_exponent), but an EXR holds 32-bit floats (at most 3.4e38), which
+// light of 1e30 leaves 10^8 of room for falloff and weights (issue 29: a point light of 1e308
+// made NaN samples, a blackbody scaled by 1e300 a black image).
+inline constexpr double kMaxEmission = 1e30;
+inline const Range kEmission = between(0, kMaxEmission);
+
+// A free form's perturbation weights lie within ±1e15: the flat free forms' polynomial
+// (frep/intersect.cpp) keeps its roots to 1e-6 there and lost them from about 1e30 (issue 29:
+// weights of 1e50 speckled the surface, 1.7e308 made holes and NaN).
+inline constexpr double kMaxPerturbationWeight = 1e15;
+
 // Reads, parses and validates a scene file; every problem is one SceneError line naming the
 // file and, inside it, the JSON path.
 SceneDesc load_scene_file(const std::string& path, const std::vector<std::string>& overrides = {});
