@@ -2,6 +2,7 @@
 // Axis-aligned boxes. An empty box has lo > hi; infinite extents are allowed.
 
 #include <limits>
+#include <utility>
 
 #include "nimbus/math/ray.h"
 #include "nimbus/math/vec3.h"
@@ -30,7 +31,29 @@ constexpr Box intersect(const Box& a, const Box& b) {
   return {max(a.lo, b.lo), min(a.hi, b.hi)};
 }
 
+// A ray with its direction's reciprocals, for clipping many boxes: the divisions once per ray.
+struct RaySlabs {
+  Vec3 o, inv;
+  explicit RaySlabs(const Ray& r) : o(r.o), inv{1.0 / r.d.x, 1.0 / r.d.y, 1.0 / r.d.z} {}
+};
+
 // Clips [t0, t1] to the part of the ray inside the box; false when nothing is left.
-bool clip_ray(const Box& box, const Ray& ray, double& t0, double& t1);
+inline bool clip_ray(const Box& box, const RaySlabs& ray, double& t0, double& t1) {
+  if (box.empty()) return false;
+  for (int i = 0; i < 3; ++i) {
+    double ta = (box.lo[i] - ray.o[i]) * ray.inv[i];
+    double tb = (box.hi[i] - ray.o[i]) * ray.inv[i];
+    if (ta > tb) std::swap(ta, tb);
+    // NaN arises for a zero direction component with the origin on a face: keep the interval.
+    if (ta > t0) t0 = ta;
+    if (tb < t1) t1 = tb;
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+inline bool clip_ray(const Box& box, const Ray& ray, double& t0, double& t1) {
+  return clip_ray(box, RaySlabs(ray), t0, t1);
+}
 
 }  // namespace nimbus

@@ -29,17 +29,6 @@ namespace integrator_detail {
 inline constexpr double kInf = std::numeric_limits<double>::infinity();
 inline constexpr double kShadowShrink = 1 - 1e-7;
 
-// The solid object containing p (the camera may sit inside one).
-inline int solid_containing(const Scene& scene, const Vec3& p) {
-  for (size_t i = 0; i < scene.objects.size(); ++i) {
-    const SceneObject& obj = scene.objects[i];
-    if (obj.surface.type == Surface::Type::Dielectric && obj.bounds.contains(p) &&
-        evaluate(obj.tape, p) > 0)
-      return static_cast<int>(i);
-  }
-  return -1;
-}
-
 // One light sample for next-event estimation at p, from the 2D number u, with the scattering
 // function's value there and the shadow ray's origin; none if the light cannot contribute.
 template <int N>

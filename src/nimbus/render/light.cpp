@@ -71,6 +71,12 @@ bool has_surface(const Light& light) {
   return light.type == Light::Type::Sphere;
 }
 
+Box surface_bounds(const Light& light) {
+  if (!has_surface(light)) return {};
+  const Vec3 r{light.radius, light.radius, light.radius};
+  return {light.center - r, light.center + r};
+}
+
 double light_fluence(const Light& light, double e, const Vec3& p) {
   switch (light.type) {
     case Light::Type::Environment:

@@ -6,6 +6,7 @@
 
 #include <optional>
 
+#include "nimbus/math/box.h"
 #include "nimbus/math/ray.h"
 #include "nimbus/math/vec3.h"
 #include "nimbus/spectral/spectral_param.h"
@@ -48,6 +49,9 @@ bool at_infinity(const Light& light);
 // Whether rays can hit the light's surface (a sphere): it is then in the scene's SurfaceIndex,
 // found by intersect and blocking shadow rays to other lights.
 bool has_surface(const Light& light);
+
+// The box around the light's surface (a sphere light's ball); empty for lights without one.
+Box surface_bounds(const Light& light);
 
 // Nearest t in (t_min, t_max) where the ray (unit direction) meets the light's surface from
 // outside; none for lights without one.

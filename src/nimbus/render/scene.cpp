@@ -1,54 +1,126 @@
 #include "nimbus/render/scene.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 #include "nimbus/spectral/planck.h"
 
 namespace nimbus {
 
-SurfaceIndex build_surface_index(const std::vector<SceneObject>& objects,
-                                 const std::vector<Light>& lights) {
-  SurfaceIndex index;
-  for (size_t i = 0; i < objects.size(); ++i)
-    if (objects[i].surface.type != Surface::Type::None) index.objects.push_back(int(i));
-  for (size_t i = 0; i < lights.size(); ++i)
-    if (has_surface(lights[i])) index.lights.push_back(int(i));
-  index.object_count = objects.size();
-  index.light_count = lights.size();
-  return index;
+namespace {
+
+// Visits the surfaces whose boxes the ray meets within [0, limit], nearer subtrees first (so
+// that hits lower `limit` early and cull more): visit(entry) may lower limit, or return true to
+// stop. A node whose box the ray enters exactly at limit is still visited (ties, surface_index.h).
+template <class Visit>
+void traverse(const SurfaceIndex& index, const RaySlabs& ray, double& limit, Visit&& visit) {
+  if (index.nodes.empty()) return;
+  // The builder's depth is below 40 + log2(entries) (surface_index.cpp): one stack entry a level.
+  std::array<std::uint32_t, 128> stack;
+  int top = 0;
+  std::uint32_t at = 0;
+  while (true) {
+    const SurfaceNode& node = index.nodes[at];
+    double t0 = 0, t1 = limit;
+    // A root that is a leaf is a short list: each entry's own test is the box test.
+    if ((at == 0 && node.count > 0) || clip_ray(node.bounds, ray, t0, t1)) {
+      if (node.count == 0) {
+        std::uint32_t near = at + 1, far = node.index;
+        if (ray.inv[node.axis] < 0) std::swap(near, far);
+        stack[top++] = far;
+        at = near;
+        continue;
+      }
+      for (std::uint32_t k = 0; k < node.count; ++k)
+        if (visit(index.entries[node.index + k])) return;
+    }
+    if (top == 0) return;
+    at = stack[--top];
+  }
 }
 
-std::optional<SurfaceHit> intersect(const Scene& scene, const Ray& ray, double t_max) {
-  std::optional<SurfaceHit> best;
-  for (const int i : scene.surfaces.objects) {
-    const SceneObject& obj = scene.objects[i];
+// Where the ray meets the index's entry e (an object, or a light past the objects) within
+// (0, t_max): over the object's box's part of the whole range, whatever was hit before, unless
+// the box begins past `beyond` (a hit there cannot be the nearest).
+std::optional<double> entry_hit(const Scene& scene, std::uint32_t e, const Ray& ray,
+                                const RaySlabs& slabs, double t_max, double beyond) {
+  const SurfaceIndex& index = scene.surfaces;
+  if (e < index.objects.size()) {
+    const SceneObject& obj = scene.objects[index.objects[e]];
     double t0 = 0, t1 = t_max;
-    if (!clip_ray(obj.bounds, ray, t0, t1)) continue;
-    if (auto t = first_hit(obj.tape, ray, t0, t1)) {
-      t_max = *t;
-      best = SurfaceHit{*t, i, -1};
-    }
+    if (!clip_ray(obj.bounds, slabs, t0, t1) || t0 > beyond) return std::nullopt;
+    return first_hit(obj.tape, ray, t0, t1);
   }
-  for (const int i : scene.surfaces.lights) {
-    if (auto t = intersect_light(scene.lights[i], ray, 0, t_max)) {
-      t_max = *t;
-      best = SurfaceHit{*t, -1, i};
+  return intersect_light(scene.lights[index.lights[e - index.objects.size()]], ray, 0, t_max);
+}
+
+}  // namespace
+
+std::optional<SurfaceHit> intersect(const Scene& scene, const Ray& ray, double t_max) {
+  const SurfaceIndex& index = scene.surfaces;
+  const RaySlabs slabs(ray);
+  double best_t = t_max;
+  auto best = std::numeric_limits<std::uint32_t>::max();
+  traverse(index, slabs, best_t, [&](std::uint32_t e) {
+    const std::optional<double> t = entry_hit(scene, e, ray, slabs, t_max, best_t);
+    // The nearest, and among equal distances the entry listed first (surface_index.h).
+    if (t && (*t < best_t || (*t == best_t && e < best))) {
+      best_t = *t;
+      best = e;
     }
+    return false;
+  });
+  if (best == std::numeric_limits<std::uint32_t>::max()) return std::nullopt;
+  const size_t objects = index.objects.size();
+  return best < objects ? SurfaceHit{best_t, index.objects[best], -1}
+                        : SurfaceHit{best_t, -1, index.lights[best - objects]};
+}
+
+int solid_containing(const Scene& scene, const Vec3& p) {
+  const SurfaceIndex& index = scene.surfaces;
+  if (index.nodes.empty()) return -1;
+  int found = -1;
+  std::array<std::uint32_t, 128> stack;  // as traverse's
+  int top = 0;
+  std::uint32_t at = 0;
+  while (true) {
+    const SurfaceNode& node = index.nodes[at];
+    if (node.bounds.contains(p)) {
+      if (node.count == 0) {
+        stack[top++] = node.index;
+        at = at + 1;
+        continue;
+      }
+      for (std::uint32_t k = 0; k < node.count; ++k) {
+        const std::uint32_t e = index.entries[node.index + k];
+        if (e >= index.objects.size()) continue;
+        const int i = index.objects[e];
+        const SceneObject& obj = scene.objects[i];
+        if ((found < 0 || i < found) && obj.surface.type == Surface::Type::Dielectric &&
+            obj.bounds.contains(p) && evaluate(obj.tape, p) > 0)
+          found = i;
+      }
+    }
+    if (top == 0) return found;
+    at = stack[--top];
   }
-  return best;
 }
 
 bool occluded(const Scene& scene, const Ray& ray, double t_max, int target_light) {
-  for (const int i : scene.surfaces.objects) {
-    const SceneObject& obj = scene.objects[i];
-    double t0 = 0, t1 = t_max;
-    if (!clip_ray(obj.bounds, ray, t0, t1)) continue;
-    if (first_hit(obj.tape, ray, t0, t1)) return true;
-  }
-  for (const int i : scene.surfaces.lights)
-    if (i != target_light && intersect_light(scene.lights[i], ray, 0, t_max)) return true;
-  return false;
+  const SurfaceIndex& index = scene.surfaces;
+  const size_t objects = index.objects.size();
+  const RaySlabs slabs(ray);
+  bool blocked = false;
+  double limit = t_max;
+  traverse(index, slabs, limit, [&](std::uint32_t e) {
+    if (e >= objects && index.lights[e - objects] == target_light) return false;
+    blocked = entry_hit(scene, e, ray, slabs, t_max, t_max).has_value();
+    return blocked;
+  });
+  return blocked;
 }
 
 Vec3 outward_normal(const SceneObject& object, const Vec3& p) {

@@ -133,6 +133,11 @@ MajorantOctree build_majorant_octree(const Scene& scene, int inside,
 // of all of them done; once cancelled, the scene must not be rendered.
 void build_majorant_octrees(Scene& scene, const BuildMonitor& monitor = {});
 
+// The solid (dielectric) object containing p, the first in scene order if several do, or -1: a
+// path that starts there (the camera may sit inside one) starts in its medium. Asks the
+// SurfaceIndex, so its cost grows with the log of the number of objects.
+int solid_containing(const Scene& scene, const Vec3& p);
+
 // The outward unit normal of an object at a point on its surface (F decreases outwards).
 Vec3 outward_normal(const SceneObject& object, const Vec3& p);
 
