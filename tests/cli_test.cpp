@@ -383,6 +383,29 @@ TEST_F(Cli, RendersThatWouldNotFitAreRefusedUpFront) {
     "objects": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}}]})");
   const Ran plain = run("render plain.json --max-memory 32M --spp 1 -o p.png");
   EXPECT_EQ(plain.code, 0) << plain.err;
+  // Issue 26: 1 024 dielectric spheres holding one homogeneous medium were refused as needing
+  // 42 GiB of octrees; each octree is one node. As many of a cloud density are still charged
+  // the node budget each, and refused.
+  nlohmann::json many = {{"film", {{"width", 16}, {"height", 16}}},
+                         {"camera", {{"from", {0, 4, 6}}, {"to", {0, 0, 0}}}},
+                         {"lights", {{{"type", "environment"}, {"radiance", 1}}}},
+                         {"media", {{"wax", {{"sigma_s", {5, 4, 3}}, {"sigma_a", 0.1}}}}},
+                         {"objects", nlohmann::json::array()}};
+  for (int i = 0; i < 1024; ++i)
+    many["objects"].push_back({{"shape",
+                                {{"type", "sphere"},
+                                 {"center", {i % 32 * 0.25 - 4, 0.1, i / 32 * 0.25 - 4}},
+                                 {"radius", 0.1}}},
+                               {"surface", {{"type", "dielectric"}}},
+                               {"medium", "wax"}});
+  write("many.json", many.dump());
+  const Ran homogeneous = run("render many.json --max-memory 256M --spp 1 -o m.png");
+  EXPECT_EQ(homogeneous.code, 0) << homogeneous.err;
+  many["media"]["wax"]["density"] = {{"type", "cloud"}};
+  write("many.json", many.dump());
+  const Ran cloudy = run("render many.json --max-memory 256M --spp 1 -o c.png");
+  EXPECT_EQ(cloudy.code, 2);
+  EXPECT_NE(cloudy.err.find("majorant octrees 42.0 GiB"), std::string::npos) << cloudy.err;
 }
 
 // Issue 29: --max-memory above what the machine can give ended in "nimbus: std::bad_alloc". Under

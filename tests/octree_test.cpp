@@ -556,11 +556,11 @@ TEST(Octree, ConstantMediumInsideASolidIsOneNode) {
   scene.objects.push_back(std::move(obj));
   build_majorant_octrees(scene);
   EXPECT_TRUE(scene.field_octree.nodes.empty());
-  ASSERT_EQ(scene.solid_octrees.size(), 1u);
-  ASSERT_EQ(scene.solid_octrees[0].nodes.size(), 1u);
+  ASSERT_EQ(scene.solid_octrees.trees.size(), 1u);
+  ASSERT_EQ(scene.solid_octrees.at(0).nodes.size(), 1u);
   for (int c = 0; c < 3; ++c) {
-    EXPECT_NEAR(node_mu_bar(scene.solid_octrees[0], 0)[c], m.sigma_s.rgb[c], 1e-9);
-    EXPECT_NEAR(node_mu_c(scene.solid_octrees[0], 0)[c], m.sigma_s.rgb[c], 1e-9);
+    EXPECT_NEAR(node_mu_bar(scene.solid_octrees.at(0), 0)[c], m.sigma_s.rgb[c], 1e-9);
+    EXPECT_NEAR(node_mu_c(scene.solid_octrees.at(0), 0)[c], m.sigma_s.rgb[c], 1e-9);
   }
 }
 

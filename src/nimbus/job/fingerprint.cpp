@@ -76,15 +76,17 @@ std::string file_difference(const nlohmann::json& saved, const nlohmann::json& n
 }  // namespace
 
 nlohmann::json render_fingerprint(const SceneDesc& desc, const std::vector<InputFile>& inputs) {
-  nlohmann::json scene = desc.document;
+  nlohmann::json fingerprint = nlohmann::json::object();
+  fingerprint["nimbus"] = NIMBUS_VERSION;
+  nlohmann::json& scene = fingerprint["scene"] = desc.document;  // the one copy
   if (scene.is_object() && scene.contains("integrator") && scene["integrator"].is_object())
     scene["integrator"].erase("spp");
   // Each file under the JSON pointer that named it, as compiling recorded it when it read it.
-  nlohmann::json files = nlohmann::json::object();
+  nlohmann::json& files = fingerprint["files"] = nlohmann::json::object();
   for (const InputFile& f : inputs)
     files[f.pointer] = {
         {"file", f.path}, {"bytes", f.bytes}, {"hash", fmt::format("{:016x}", f.hash)}};
-  return {{"nimbus", NIMBUS_VERSION}, {"scene", scene}, {"files", files}};
+  return fingerprint;
 }
 
 nlohmann::json render_fingerprint(const nlohmann::json& identity) {
@@ -108,7 +110,7 @@ std::string fingerprint_difference(const nlohmann::json& saved, const nlohmann::
 
 uint64_t majorant_hash(const Scene& scene) {
   uint64_t h = hash_octree(scene.field_octree, kFnvOffset);
-  for (const MajorantOctree& t : scene.solid_octrees) h = hash_octree(t, h);
+  for (const MajorantOctree& t : scene.solid_octrees.trees) h = hash_octree(t, h);
   return h;
 }
 

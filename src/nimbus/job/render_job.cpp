@@ -102,7 +102,8 @@ void RenderJob::check() const {
 
 bool RenderJob::compile(const BuildMonitor& monitor) {
   scene_ = compile_scene(desc_, monitor, &inputs_);
-  fingerprint_ = render_fingerprint(desc_, inputs_);
+  // A copy of the whole document (issue 26: 1.7 KB an object), for checkpoints only.
+  if (!checkpoint_file_.empty()) fingerprint_ = render_fingerprint(desc_, inputs_);
   compiled_ = !(monitor.cancel && monitor.cancel());
   return compiled_;
 }
@@ -244,12 +245,16 @@ std::vector<NamedFile> RenderJob::files_written() const {
 
 void check_render_memory(const SceneDesc& desc, int threads, std::optional<uint64_t> max_memory) {
   // One per solid holding a medium, and the field's if an index-matched object holds one
-  // (render/scene.h); none for a scene without media (issue 29: 42 MiB were charged for it).
+  // (render/scene.h); none for a scene without media (issue 29: 42 MiB were charged for it). A
+  // solid of constant density is homogeneous: its octree is one node, never split (media/
+  // octree.h), and is not charged the node budget (issue 26: 1 024 dielectric spheres of one
+  // homogeneous medium were refused as needing 42 GiB).
   int octrees = 0;
   bool field = false;
   for (const ObjectDesc& o : desc.objects) {
     const int medium = compiled_medium(o);
-    octrees += has_own_octree(medium, o.surface.type);
+    if (has_own_octree(medium, o.surface.type))
+      octrees += !desc.media[size_t(medium)].constant_density;
     field = field || (medium >= 0 && !has_own_octree(medium, o.surface.type));
   }
   octrees += field;

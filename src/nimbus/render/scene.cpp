@@ -170,10 +170,12 @@ void build_majorant_octrees(Scene& scene, const BuildMonitor& monitor) {
     return m;
   };
   scene.field_octree = build_majorant_octree(scene, -1, part(0));
-  scene.solid_octrees.assign(scene.objects.size(), MajorantOctree{});
+  scene.solid_octrees.of_object.assign(scene.objects.size(), -1);
+  scene.solid_octrees.trees.clear();
   for (size_t k = 0; k < solids.size(); ++k) {
     if (monitor.cancel && monitor.cancel()) return;
-    scene.solid_octrees[solids[k]] = build_majorant_octree(scene, solids[k], part(k + 1));
+    scene.solid_octrees.of_object[solids[k]] = static_cast<int>(k);
+    scene.solid_octrees.trees.push_back(build_majorant_octree(scene, solids[k], part(k + 1)));
   }
 }
 

@@ -77,6 +77,19 @@ inline bool has_own_octree(int medium, Surface::Type surface) {
   return medium >= 0 && surface != Surface::Type::None;
 }
 
+// The majorant octrees of the solid objects holding a medium, by object index: a slot per object
+// (8 bytes; issue 26: an empty octree per object took 544), a tree per such solid.
+struct SolidOctrees {
+  std::vector<int> of_object;         // per object: its tree's index in `trees`, or -1
+  std::vector<MajorantOctree> trees;  // in object order
+  // The object's octree; an empty one for an object without.
+  const MajorantOctree& at(size_t object) const {
+    static const MajorantOctree none;
+    const int k = object < of_object.size() ? of_object[object] : -1;
+    return k >= 0 ? trees[size_t(k)] : none;
+  }
+};
+
 struct Scene {
   Camera camera;
   RenderSettings settings;
@@ -87,7 +100,7 @@ struct Scene {
   // Majorants and minorants (build_majorant_octrees): of the field, and inside each solid
   // object holding a medium (indexed by object; empty for the others).
   MajorantOctree field_octree;
-  std::vector<MajorantOctree> solid_octrees;
+  SolidOctrees solid_octrees;
   SurfaceIndex surfaces;  // what `intersect` and `occluded` search (finish_scene builds it)
   double scale = 1;       // size of the scene's bounds, for ray offsets
   // The exponent of its films (film.h: film_exponent of brightest_emission; finish_scene).

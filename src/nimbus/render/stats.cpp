@@ -59,7 +59,7 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
     depth = std::max(depth, t.depth);
   };
   add(scene.field_octree);
-  for (const MajorantOctree& t : scene.solid_octrees) add(t);
+  for (const MajorantOctree& t : scene.solid_octrees.trees) add(t);
   j["octree"] = {{"build_seconds", build_seconds},
                  {"nodes", nodes},
                  {"bytes", bytes},

@@ -286,6 +286,7 @@ class Loader {
       if (auto s = d.optional("scale")) m.density_scale = s->number(at_least(0));
       for (const DensityType& t : density_types())
         if (t.name == type) m.density = t.read(d);
+      m.constant_density = type == "constant";
       d.finish(fmt::format("for density type \"{}\"", type));
     }
     o.finish();

@@ -49,6 +49,7 @@ struct MediumDesc {
   // How compile_scene makes the density (its type's reader, scene/density_types.h, checked the
   // keys; a "vdb" density's file is read then).
   Deferred<DensityPtr> density = [](std::vector<InputFile>&) { return make_constant_density(); };
+  bool constant_density = true;  // the density is the "constant" type: its octree is one node
   double density_scale = 1;
 };
 
