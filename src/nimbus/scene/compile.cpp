@@ -103,7 +103,7 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
     const int medium = compiled_medium(od);
     const bool reads_F = medium >= 0 && scene.media[medium].density->uses_F();
     obj.tape = compile(*od.shape, reads_F ? FUse::Value : FUse::Sign);
-    const Bounds b = compute_bounds(obj.tape);
+    const Bounds& b = obj.tape.bounds;  // compile() computed them
     if (!b.bounded)
       throw SceneError(fmt::format(
           "{}: {}/shape: shape \"{}\" is unbounded; clip it with an intersection (e.g. a box)",
