@@ -38,6 +38,7 @@ set(NIMBUS_PUBLIC_HEADERS
     render/exact_sum.h
     render/film.h
     render/light.h
+    render/light_tree.h
     render/material.h
     render/renderer.h
     render/scene.h

@@ -91,6 +91,66 @@ TEST(LightChoice, PicksFollowTheProbabilities) {
   }
 }
 
+// Issue 26: with many positioned lights the pick descends a light tree (light_tree.h). The
+// probabilities sum to 1, choose_light reports what light_choice_pdf says, the draws follow
+// them (chi-square), and every light with power has a positive probability everywhere.
+TEST(LightChoice, TheLightTreePicksFollowTheProbabilities) {
+  Lights l;
+  Light env, sun;
+  env.type = Light::Type::Environment;
+  sun.type = Light::Type::Directional;
+  sun.direction = {0, -1, 0};
+  l.add(env, Rgb(0.2));
+  l.add(sun, Rgb(0.5));
+  Rng place(3);
+  for (int k = 0; k < 62; ++k) {
+    Light light;
+    light.type = k % 2 ? Light::Type::Point : Light::Type::Sphere;
+    light.position =
+        light.center = {6 * place.uniform() - 3, 3 * place.uniform(), 6 * place.uniform() - 3};
+    light.radius = 0.05 + 0.2 * place.uniform();
+    l.add(light, Rgb({place.uniform(), 2 * place.uniform(), 0.5}));
+  }
+  l.scene.light_tree = build_light_tree(l.scene.lights);
+  ASSERT_FALSE(l.scene.light_tree.nodes.empty());
+  const int n = int(l.scene.lights.size());
+  for (const Vec3& p : {Vec3{0, 0, 0}, Vec3{2.5, 1, 0}, Vec3{-40, 0.1, 70}}) {
+    std::vector<double> pdf(n);
+    double total = 0;
+    for (int i = 0; i < n; ++i) total += pdf[i] = light_choice_pdf(l.scene, l.ps, i, p);
+    EXPECT_NEAR(total, 1, 1e-12);
+    EXPECT_EQ(pdf[0], 0);  // the sky is left to BSDF sampling while the others shine
+    for (int i = 1; i < n; ++i) EXPECT_GT(pdf[i], 0) << i;
+    const int draws = 200000;
+    std::vector<int> count(n, 0);
+    Rng rng(43);
+    for (int k = 0; k < draws; ++k) {
+      const auto [i, q] = choose_light(l.scene, l.ps, p, rng.uniform());
+      ASSERT_NEAR(q, pdf[i], 1e-12 * pdf[i]) << i;
+      ++count[i];
+    }
+    // Cells of at least 5 expected draws; the rest pooled.
+    double chi2 = 0, pooled_expected = 0;
+    int cells = 0, pooled = 0;
+    for (int i = 0; i < n; ++i) {
+      const double expected = draws * pdf[i];
+      if (expected < 5) {
+        pooled_expected += expected;
+        pooled += count[i];
+        continue;
+      }
+      chi2 += (count[i] - expected) * (count[i] - expected) / expected;
+      ++cells;
+    }
+    if (pooled_expected >= 5) {
+      chi2 += (pooled - pooled_expected) * (pooled - pooled_expected) / pooled_expected;
+      ++cells;
+    }
+    ASSERT_GE(cells, 10);
+    EXPECT_LT(chi2, test::chi_square_critical(cells - 1, 1e-4));
+  }
+}
+
 // A constant sky is left to BSDF and phase sampling while another light has fluence; alone, it
 // is picked.
 TEST(LightChoice, EnvironmentOnlyWhenAlone) {

@@ -50,7 +50,7 @@ std::optional<LightCandidate<N>> light_candidate(const Scene& scene, const PathS
   if (on_surface && dot(ls->wi, n) <= 0) return std::nullopt;
   const Spectrum<N> fv = f(ls->wi);
   if (fv.is_black()) return std::nullopt;
-  return LightCandidate<N>{*ls, fv, ps.lights[light_index] * ls->falloff,
+  return LightCandidate<N>{*ls, fv, light_emission(ps, scene, light_index) * ls->falloff,
                            on_surface ? offset_origin(scene, p, n, ls->wi) : p};
 }
 
@@ -186,15 +186,15 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
     }
 
     if (!hit) {
-      for (size_t i = 0; i < scene.lights.size(); ++i)
-        if (at_infinity(scene.lights[i]))
-          L += policy.light_hit(ps.lights[i], scene.lights[i], prev_p, ray.d, light_sampled,
-                                light_sampling_pdf(scene, ps, int(i), prev_p));
+      for (const int i : scene.lights_at_infinity)
+        L += policy.light_hit(light_emission(ps, scene, i), scene.lights[i], prev_p, ray.d,
+                              light_sampled, light_sampling_pdf(scene, ps, i, prev_p));
       break;
     }
     if (hit->light >= 0) {
-      L += policy.light_hit(ps.lights[hit->light], scene.lights[hit->light], prev_p, ray.d,
-                            light_sampled, light_sampling_pdf(scene, ps, hit->light, prev_p));
+      L +=
+          policy.light_hit(light_emission(ps, scene, hit->light), scene.lights[hit->light], prev_p,
+                           ray.d, light_sampled, light_sampling_pdf(scene, ps, hit->light, prev_p));
       break;
     }
     const SceneObject& obj = scene.objects[hit->object];

@@ -16,6 +16,7 @@
 
 #include "nimbus/math/constants.h"
 #include "nimbus/render/light.h"
+#include "nimbus/render/light_tree.h"
 #include "nimbus/render/path_spectra.h"
 #include "nimbus/render/scene.h"
 
@@ -39,7 +40,31 @@ double light_choice_weight(const Scene& scene, const PathSpectra<N>& ps, int j, 
                            bool skip_environment) {
   const Light& light = scene.lights[j];
   if (skip_environment && at_infinity(light)) return 0;
-  return light_fluence(light, ps.lights[j], p);
+  return light_fluence(light, light_emission(ps, scene, j), p);
+}
+
+// With a light tree (many positioned lights, light_tree.h), the choice weighs the lights
+// outside it (sky, suns) as above and the tree as one more candidate whose weight is its root's
+// importance at p, then descends the tree. `others` is the sum of the outside lights' weights.
+struct TreeChoice {
+  double others = 0, tree = 0, total = 0;
+  bool skip = true;  // a constant environment gets weight 0
+};
+
+template <int N>
+TreeChoice tree_choice(const Scene& scene, const PathSpectra<N>& ps, const Vec3& p) {
+  TreeChoice c;
+  c.tree = light_node_importance(scene.light_tree.nodes[0], p);
+  for (const int j : scene.light_tree.others)
+    c.others += light_choice_weight(scene, ps, j, p, true);
+  c.total = c.others + c.tree;
+  if (c.total > 0 && std::isfinite(c.total)) return c;
+  c.skip = false;
+  c.others = 0;
+  for (const int j : scene.light_tree.others)
+    c.others += light_choice_weight(scene, ps, j, p, false);
+  c.total = c.others + c.tree;
+  return c;
 }
 
 // The sum of the weights, with the choice whether to skip environments.
@@ -58,6 +83,13 @@ std::pair<double, bool> light_choice_total(const Scene& scene, const PathSpectra
 // The probability with which choose_light picks light i at p.
 template <int N>
 double light_choice_pdf(const Scene& scene, const PathSpectra<N>& ps, int i, const Vec3& p) {
+  if (!scene.light_tree.nodes.empty()) {
+    const TreeChoice c = tree_choice(scene, ps, p);
+    if (!(c.total > 0) || !std::isfinite(c.total)) return 1.0 / double(scene.lights.size());
+    if (scene.light_tree.depth[size_t(i)] < 0)
+      return light_choice_weight(scene, ps, i, p, c.skip) / c.total;
+    return c.tree / c.total * light_tree_pdf(scene.light_tree, i, p);
+  }
   const auto [total, skip] = light_choice_total(scene, ps, p);
   if (!(total > 0) || !std::isfinite(total)) return 1.0 / double(scene.lights.size());
   return light_choice_weight(scene, ps, i, p, skip) / total;
@@ -68,6 +100,23 @@ template <int N>
 std::pair<int, double> choose_light(const Scene& scene, const PathSpectra<N>& ps, const Vec3& p,
                                     double u) {
   const int n = static_cast<int>(scene.lights.size());
+  if (!scene.light_tree.nodes.empty()) {
+    const TreeChoice c = tree_choice(scene, ps, p);
+    if (!(c.total > 0) || !std::isfinite(c.total)) {
+      const int i = std::min(n - 1, static_cast<int>(u * n));
+      return {i, 1.0 / n};
+    }
+    double below = 0;
+    for (const int j : scene.light_tree.others) {
+      const double w = light_choice_weight(scene, ps, j, p, c.skip);
+      if (w > 0 && u * c.total < below + w) return {j, w / c.total};
+      below += w;
+    }
+    // The rest of [0, 1) is the tree's: u rescaled into [0, 1) for the descent.
+    const double v = std::clamp((u * c.total - below) / c.tree, 0.0, 0x1.fffffffffffffp-1);
+    const auto [j, pdf] = descend_light_tree(scene.light_tree, p, v);
+    return {j, c.tree / c.total * pdf};
+  }
   const auto [total, skip] = light_choice_total(scene, ps, p);
   if (!(total > 0) || !std::isfinite(total)) {
     const int i = std::min(n - 1, static_cast<int>(u * n));

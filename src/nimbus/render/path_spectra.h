@@ -23,8 +23,18 @@ template <int N>
 struct PathSpectra {
   Channels<N> ch;
   std::vector<MediumCoefficients<N>> media;  // indexed as scene.media
-  std::vector<Spectrum<N>> lights;           // each light's emission, indexed as scene.lights
+  // Each light's emission, indexed as scene.lights, for a scene of few lights (no light tree);
+  // with thousands, evaluating them all per path cost more than the path (issue 26), and
+  // light_emission evaluates the one asked for.
+  std::vector<Spectrum<N>> lights;
 };
+
+// Light l's emission at the path's channels.
+template <int N>
+Spectrum<N> light_emission(const PathSpectra<N>& ps, const Scene& scene, int l) {
+  return size_t(l) < ps.lights.size() ? ps.lights[size_t(l)]
+                                      : evaluate(scene.lights[size_t(l)].emission, ps.ch);
+}
 
 // The octree bounds mu_t = density · sigma_t per wavelength bin, with each medium's sigma_t at its
 // upper bound over the bin (SpectralParam::bin_max); a channel's own mu_t is bounded by that
@@ -77,8 +87,8 @@ void prepare_path_spectra(PathSpectra<N>& ps, const Scene& scene, double u) {
     }
   }
   if (ps.ch.spectral) channel_majorant_factors(ps, scene);
-  ps.lights.resize(scene.lights.size());
-  for (size_t l = 0; l < scene.lights.size(); ++l)
+  ps.lights.resize(scene.light_tree.nodes.empty() ? scene.lights.size() : 0);
+  for (size_t l = 0; l < ps.lights.size(); ++l)
     ps.lights[l] = evaluate(scene.lights[l].emission, ps.ch);
 }
 

@@ -14,6 +14,7 @@
 #include "nimbus/render/camera.h"
 #include "nimbus/render/film.h"
 #include "nimbus/render/light.h"
+#include "nimbus/render/light_tree.h"
 #include "nimbus/render/material.h"
 #include "nimbus/render/surface_index.h"
 
@@ -102,7 +103,9 @@ struct Scene {
   MajorantOctree field_octree;
   SolidOctrees solid_octrees;
   SurfaceIndex surfaces;  // what `intersect` and `occluded` search (finish_scene builds it)
-  double scale = 1;       // size of the scene's bounds, for ray offsets
+  LightTree light_tree;   // for picking one of many lights (finish_scene builds it)
+  std::vector<int> lights_at_infinity;  // what a ray that leaves the scene meets (finish_scene)
+  double scale = 1;                     // size of the scene's bounds, for ray offsets
   // The exponent of its films (film.h: film_exponent of brightest_emission; finish_scene).
   int film_exponent = 0;
 };

@@ -160,6 +160,10 @@ void finish_scene(Scene& scene, const BuildMonitor& monitor) {
   if (!all.empty()) scene.scale = length(all.extent());
   scene.surfaces = build_surface_index(scene.objects, scene.lights);
   complete_spectra(scene);
+  scene.light_tree = build_light_tree(scene.lights);  // after the spectra: powers read bin_max
+  scene.lights_at_infinity.clear();
+  for (size_t i = 0; i < scene.lights.size(); ++i)
+    if (at_infinity(scene.lights[i])) scene.lights_at_infinity.push_back(int(i));
   scene.film_exponent = film_exponent(brightest_emission(scene));
   build_majorant_octrees(scene, monitor);
 }
