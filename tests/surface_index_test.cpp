@@ -117,7 +117,7 @@ int depth_of(const SurfaceIndex& index, std::uint32_t at = 0) {
 void expect_as_the_list(const Scene& scene, uint64_t seed, double spread) {
   Rng rng(seed, 11);
   int hits = 0;
-  for (int i = 0; i < 4000; ++i) {
+  for (int i = 0; i < 3000; ++i) {
     // From outside and from inside the cloud of objects; some directions along the axes, whose
     // zero components the box tests must survive.
     const Vec3 o = random_in_cube(rng, i % 2 ? 2 * spread : 0.5 * spread);
@@ -142,7 +142,7 @@ void expect_as_the_list(const Scene& scene, uint64_t seed, double spread) {
 }
 
 TEST(SurfaceIndex, NearestHitsAreTheListsBitForBit) {
-  for (const int n : {1, 7, 64, 700}) {
+  for (const int n : {1, 7, 64, 400}) {
     const double spread = 0.5 * std::cbrt(double(n)) + 0.5;
     const Scene scene = scattered_scene(n, spread, uint64_t(n));
     expect_as_the_list(scene, uint64_t(n) + 100, spread);
@@ -152,12 +152,12 @@ TEST(SurfaceIndex, NearestHitsAreTheListsBitForBit) {
 // The solid a path starting at a point is in: the first dielectric object in scene order whose
 // F is positive there, as a scan of every object finds it.
 TEST(SurfaceIndex, TheSolidContainingAPointIsTheScansFirst) {
-  for (const int n : {40, 700}) {
+  for (const int n : {40, 400}) {
     const double spread = 0.5 * std::cbrt(double(n)) + 0.5;
     const Scene scene = scattered_scene(n, spread, uint64_t(n) + 7);
     Rng rng(uint64_t(n), 13);
     int inside = 0;
-    for (int i = 0; i < 20000; ++i) {
+    for (int i = 0; i < 8000; ++i) {
       const Vec3 p = random_in_cube(rng, spread);
       int expected = -1;
       for (size_t k = 0; k < scene.objects.size() && expected < 0; ++k) {
@@ -175,7 +175,7 @@ TEST(SurfaceIndex, TheSolidContainingAPointIsTheScansFirst) {
 
 // Every surface once in the leaves, every box holding its children's, a bounded depth.
 TEST(SurfaceIndex, TheHierarchyHoldsEverySurfaceOnce) {
-  const Scene scene = scattered_scene(1000, 5, 5);
+  const Scene scene = scattered_scene(600, 4, 5);
   const SurfaceIndex& index = scene.surfaces;
   EXPECT_EQ(index.entries.size(), index.objects.size() + index.lights.size());
   std::multiset<std::uint32_t> seen(index.entries.begin(), index.entries.end());
@@ -204,10 +204,10 @@ TEST(SurfaceIndex, TheHierarchyHoldsEverySurfaceOnce) {
   walk(0);
   EXPECT_LT(depth_of(index), 40);
   // Coincident boxes cannot be told apart by the SAH; splits by count keep the depth bounded.
-  std::vector<SceneObject> same(5000, scene.objects[0]);
+  std::vector<SceneObject> same(2000, scene.objects[0]);
   const SurfaceIndex stacked = build_surface_index(same, {});
-  EXPECT_EQ(stacked.entries.size(), 5000u);
-  EXPECT_LE(depth_of(stacked), 12);  // ⌈log2(5000 / 4)⌉ + 1
+  EXPECT_EQ(stacked.entries.size(), 2000u);
+  EXPECT_LE(depth_of(stacked), 10);  // ⌈log2(2000 / 4)⌉ + 1
 }
 
 // A scene without surfaces has an empty index, and rays meet nothing.
