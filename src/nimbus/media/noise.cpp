@@ -22,6 +22,14 @@ constexpr double lerp(double a, double b, double s) {
   return a + s * (b - a);
 }
 
+// The lattice repeats every 256 cells, so a coordinate far out (past 2^52, where a double has no
+// fraction left, and past 2^63, where it has no int64 for the cell) is reduced into one period
+// first (exactly: fmod is exact); a coordinate that is not finite reads the origin's cell.
+double wrapped(double v) {
+  if (std::abs(v) < 0x1p52) return v;
+  return std::isfinite(v) ? std::fmod(v, 256.0) : 0.0;
+}
+
 }  // namespace
 
 Noise make_noise(uint64_t seed) {
@@ -40,18 +48,6 @@ Noise make_noise(uint64_t seed) {
   }
   return n;
 }
-
-namespace {
-
-// The lattice repeats every 256 cells, so a coordinate far out (past 2^52, where a double has no
-// fraction left, and past 2^63, where it has no int64 for the cell) is reduced into one period
-// first (exactly: fmod is exact); a coordinate that is not finite reads the origin's cell.
-double wrapped(double v) {
-  if (std::abs(v) < 0x1p52) return v;
-  return std::isfinite(v) ? std::fmod(v, 256.0) : 0.0;
-}
-
-}  // namespace
 
 double noise(const Noise& n, const Vec3& x_in) {
   const Vec3 x{wrapped(x_in.x), wrapped(x_in.y), wrapped(x_in.z)};

@@ -11,9 +11,7 @@ namespace {
 // The light's power in its largest channel (RGB or a spectral bin): the tree's weights are the
 // same for every path, whatever its wavelengths.
 double light_power(const Light& light) {
-  double e = light.emission.rgb.max();
-  for (double b : light.emission.bin_max) e = std::max(e, b);
-  e = std::max(e, 0.0);
+  const double e = std::max(largest_value(light.emission), 0.0);
   return light.type == Light::Type::Point ? e : e * kPi * light.radius * light.radius;
 }
 

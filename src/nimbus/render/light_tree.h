@@ -53,14 +53,19 @@ inline double light_node_importance(const LightTreeNode& node, const Vec3& p) {
   return node.power / (d2 > r2 ? d2 : r2 > 0 ? r2 : 1e-300);
 }
 
+// The probability of descending from inner node `at` to its first child at p.
+inline double first_child_probability(const LightTree& tree, std::uint32_t at, const Vec3& p) {
+  const double a = light_node_importance(tree.nodes[at + 1], p);
+  const double b = light_node_importance(tree.nodes[tree.nodes[at].index], p);
+  return a + b > 0 ? a / (a + b) : 0.5;
+}
+
 // A light of the tree picked at p from u in [0, 1), and the probability of the descent.
 inline std::pair<int, double> descend_light_tree(const LightTree& tree, const Vec3& p, double u) {
   std::uint32_t at = 0;
   double pdf = 1;
   while (!tree.nodes[at].leaf) {
-    const double a = light_node_importance(tree.nodes[at + 1], p);
-    const double b = light_node_importance(tree.nodes[tree.nodes[at].index], p);
-    const double p_first = a + b > 0 ? a / (a + b) : 0.5;
+    const double p_first = first_child_probability(tree, at, p);
     if (u < p_first) {
       u /= p_first;
       pdf *= p_first;
@@ -84,9 +89,7 @@ inline double light_tree_pdf(const LightTree& tree, int light, const Vec3& p) {
   std::uint32_t at = 0;
   double pdf = 1;
   for (int level = 0; level < depth; ++level) {
-    const double a = light_node_importance(tree.nodes[at + 1], p);
-    const double b = light_node_importance(tree.nodes[tree.nodes[at].index], p);
-    const double p_first = a + b > 0 ? a / (a + b) : 0.5;
+    const double p_first = first_child_probability(tree, at, p);
     if (trail >> level & 1) {
       pdf *= 1 - p_first;
       at = tree.nodes[at].index;

@@ -188,25 +188,15 @@ void build_majorant_octrees(Scene& scene, const BuildMonitor& monitor) {
   }
 }
 
-namespace {
-
-// The largest value of an emitted colour in rgb mode (a channel) or spectral mode (a bin's bound).
-double largest(const SpectralParam& p) {
-  double m = p.rgb.max();
-  for (double b : p.bin_max) m = std::max(m, b);
-  return m;
-}
-
-}  // namespace
-
 double brightest_emission(const Scene& scene) {
   double b = 0;
-  for (const Light& light : scene.lights) b = std::max(b, largest(light.emission));
+  for (const Light& light : scene.lights) b = std::max(b, largest_value(light.emission));
   for (const SceneObject& obj : scene.objects) {
-    if (obj.surface.type == Surface::Type::Emissive) b = std::max(b, largest(obj.surface.radiance));
+    if (obj.surface.type == Surface::Type::Emissive)
+      b = std::max(b, largest_value(obj.surface.radiance));
     if (obj.medium < 0) continue;
     const Medium& m = scene.media[obj.medium];
-    b = std::max(b, largest(m.emission));
+    b = std::max(b, largest_value(m.emission));
     if (m.emission_grid) {
       // The hottest temperature the grid interpolates to inside the object, from the grid's own
       // extrema (vdb_density.h); B's peak and its rgb both grow with the temperature.

@@ -74,12 +74,11 @@ class Builder {
     for (size_t i = first; i < last; ++i) index_.entries.push_back(items_[i].id);
   }
 
-  // The binned SAH split of [first, last) (Wald 2007): false when no split beats a leaf of up
-  // to kMaxLeafSize items or the centroids coincide; else partitions and sets axis and mid.
+  // The binned SAH split of [first, last) (Wald 2007), called above kMaxLeafSize items: false
+  // when the centroids coincide on every axis; else partitions and sets axis and mid.
   bool sah_split(const Box& bounds, const Box& centroids, size_t first, size_t last, int& axis,
                  size_t& mid) {
-    const size_t n = last - first;
-    double best_cost = n <= size_t(kMaxLeafSize) ? double(n) : kInfinity;
+    double best_cost = kInfinity;
     int best_axis = -1, best_bin = 0;
     for (int a = 0; a < 3; ++a) {
       const double lo = centroids.lo[a], width = centroids.hi[a] - lo;

@@ -30,6 +30,14 @@ struct SpectralParam {
   SpectralParam(const Rgb& value) : rgb(value) {}  // NOLINT: scenes built in code give RGB
 };
 
+// The largest value p takes: of its RGB channels and, once complete_spectrum has filled them, of
+// its spectral bins' bounds.
+inline double largest_value(const SpectralParam& p) {
+  double m = p.rgb.max();
+  for (double b : p.bin_max) m = m > b ? m : b;
+  return m;
+}
+
 // Gives p its curve from its RGB if it has none, and fills its bin_max from its curve.
 void complete_spectrum(SpectralParam& p, SpectralRole role);
 
