@@ -12,13 +12,13 @@ namespace nimbus {
 
 namespace {
 
-// Visits the surfaces whose boxes the ray meets within [0, limit], nearer subtrees first (so
-// that hits lower `limit` early and cull more): visit(entry) may lower limit, or return true to
-// stop. A node whose box the ray enters exactly at limit is still visited (ties, surface_index.h).
-template <class Visit>
-void traverse(const SurfaceIndex& index, const RaySlabs& ray, double& limit, Visit&& visit) {
+// Visits the entries of the leaves whose nodes `enter` accepts, the child `second_first` names
+// first; visit(entry) returns true to stop. A root that is a leaf is a short list, visited
+// without a node test: each entry's own test is the box test.
+template <class Enter, class SecondFirst, class Visit>
+void walk(const SurfaceIndex& index, Enter&& enter, SecondFirst&& second_first, Visit&& visit) {
   if (index.nodes.empty()) return;
-  if (index.nodes[0].count > 0) {  // a short list: each entry's own test is the box test
+  if (index.nodes[0].count > 0) {
     for (const std::uint32_t e : index.entries)
       if (visit(e)) return;
     return;
@@ -29,13 +29,12 @@ void traverse(const SurfaceIndex& index, const RaySlabs& ray, double& limit, Vis
   std::uint32_t at = 0;
   while (true) {
     const SurfaceNode& node = index.nodes[at];
-    double t0 = 0, t1 = limit;
-    if (clip_ray(node.bounds, ray, t0, t1)) {
+    if (enter(node)) {
       if (node.count == 0) {
-        std::uint32_t near = at + 1, far = node.index;
-        if (ray.inv[node.axis] < 0) std::swap(near, far);
-        stack[top++] = far;
-        at = near;
+        std::uint32_t first = at + 1, second = node.index;
+        if (second_first(node)) std::swap(first, second);
+        stack[top++] = second;
+        at = first;
         continue;
       }
       for (std::uint32_t k = 0; k < node.count; ++k)
@@ -44,6 +43,20 @@ void traverse(const SurfaceIndex& index, const RaySlabs& ray, double& limit, Vis
     if (top == 0) return;
     at = stack[--top];
   }
+}
+
+// Visits the surfaces whose boxes the ray meets within [0, limit], nearer subtrees first (so
+// that hits lower `limit` early and cull more): visit(entry) may lower limit, or return true to
+// stop. A node whose box the ray enters exactly at limit is still visited (ties, surface_index.h).
+template <class Visit>
+void traverse(const SurfaceIndex& index, const RaySlabs& ray, double& limit, Visit&& visit) {
+  walk(
+      index,
+      [&](const SurfaceNode& node) {
+        double t0 = 0, t1 = limit;
+        return clip_ray(node.bounds, ray, t0, t1);
+      },
+      [&](const SurfaceNode& node) { return ray.inv[node.axis] < 0; }, visit);
 }
 
 // Where the ray meets the index's entry e (an object, or a light past the objects) within
@@ -90,32 +103,20 @@ std::optional<SurfaceHit> intersect(const Scene& scene, const Ray& ray, double t
 
 int solid_containing(const Scene& scene, const Vec3& p) {
   const SurfaceIndex& index = scene.surfaces;
-  if (index.nodes.empty()) return -1;
   int found = -1;
-  std::array<std::uint32_t, 128> stack;  // as traverse's
-  int top = 0;
-  std::uint32_t at = 0;
-  while (true) {
-    const SurfaceNode& node = index.nodes[at];
-    if (node.bounds.contains(p)) {
-      if (node.count == 0) {
-        stack[top++] = node.index;
-        at = at + 1;
-        continue;
-      }
-      for (std::uint32_t k = 0; k < node.count; ++k) {
-        const std::uint32_t e = index.entries[node.index + k];
-        if (e >= index.objects.size()) continue;
+  walk(
+      index, [&](const SurfaceNode& node) { return node.bounds.contains(p); },
+      [](const SurfaceNode&) { return false; },
+      [&](std::uint32_t e) {
+        if (e >= index.objects.size()) return false;
         const int i = index.objects[e];
-        const SceneObject& obj = scene.objects[i];
+        const SceneObject& obj = scene.objects[size_t(i)];
         if ((found < 0 || i < found) && obj.surface.type == Surface::Type::Dielectric &&
             obj.bounds.contains(p) && evaluate(obj.tape, p) > 0)
           found = i;
-      }
-    }
-    if (top == 0) return found;
-    at = stack[--top];
-  }
+        return false;
+      });
+  return found;
 }
 
 bool occluded(const Scene& scene, const Ray& ray, double t_max, int target_light) {
