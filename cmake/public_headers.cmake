@@ -28,6 +28,7 @@ set(NIMBUS_PUBLIC_HEADERS
     media/density.h
     media/field_density.h
     media/medium.h
+    media/member_grid.h
     media/noise.h
     media/octree.h
     media/temperature_emission.h

@@ -523,9 +523,21 @@ TEST(Octree, DepthZeroIsOneNodeAndDeepTreesStayBounded) {
   const Scene deep = three_media(kOctreeMaxDepth);
   EXPECT_LE(deep.field_octree.nodes.size(), kOctreeMaxNodes);
   EXPECT_GE(deep.field_octree.depth, 5);
-  EXPECT_EQ(deep.field_octree.bytes(), sizeof(MajorantOctree) +
-                                           deep.field_octree.nodes.size() * sizeof(OctreeNode) +
-                                           deep.field_octree.nodes.size() * 2 * 3 * sizeof(double));
+  // The leaves list the media objects near them: at most all three, once each.
+  const MajorantOctree& t = deep.field_octree;
+  ASSERT_EQ(t.member_begin.size(), t.nodes.size() + 1);
+  size_t leaves = 0;
+  for (size_t i = 0; i < t.nodes.size(); ++i) {
+    const auto listed = t.leaf_members(static_cast<std::int32_t>(i));
+    EXPECT_LE(listed.size(), 3u);
+    EXPECT_TRUE(std::is_sorted(listed.begin(), listed.end()));
+    leaves += t.nodes[i].children < 0;
+  }
+  EXPECT_LE(t.members.size(), 3 * leaves);
+  EXPECT_EQ(t.bytes(), sizeof(MajorantOctree) + t.nodes.size() * sizeof(OctreeNode) +
+                           t.nodes.size() * 2 * 3 * sizeof(double) +
+                           (t.nodes.size() + 1) * sizeof(std::uint32_t) +
+                           t.members.size() * sizeof(std::int32_t));
 }
 
 TEST(Octree, ASmallDenseFeatureIsRefinedToTheFullDepth) {

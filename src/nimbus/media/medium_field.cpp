@@ -32,6 +32,13 @@ bool add_span(MediumIntervals& m, double a, double b) {
   return true;
 }
 
+void drop_spans_before(MediumIntervals& m, double t) {
+  int first = 0;
+  while (first < m.count && m.spans[first].t1 <= t) ++first;
+  std::copy(m.spans.begin() + first, m.spans.begin() + m.count, m.spans.begin());
+  m.count -= first;
+}
+
 namespace {
 
 // One quadric's stretches with F > 0 over [a, b], from both its roots at once (the general

@@ -7,6 +7,8 @@
 // what the media layer needs (media_scene.h).
 
 #include <array>
+#include <cstdint>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -15,6 +17,7 @@
 #include "nimbus/math/ray.h"
 #include "nimbus/media/media_scene.h"
 #include "nimbus/media/medium.h"
+#include "nimbus/media/member_grid.h"
 #include "nimbus/media/octree.h"
 #include "nimbus/media/phase.h"
 #include "nimbus/spectral/channels.h"
@@ -22,25 +25,29 @@
 
 namespace nimbus {
 
-inline constexpr int kMaxMediaAtPoint = 8;
+// Any number of media may overlap at a point; media of one anisotropy g share one lobe of the
+// mixture phase function (the mixture is Σ_i mu_s,i HG(g_i) / mu_s, so their mu_s,i add). The
+// index-matched media of a scene may have at most this many different g (compile.h checks);
+// inside a solid only its own medium is present.
+inline constexpr int kMaxPhaseLobes = 16;
 
 // The coefficients at a point, with the phase function of the mixture of media present there.
 template <int N>
 struct MediumPoint {
-  static constexpr int kMaxMedia = kMaxMediaAtPoint;
   Spectrum<N> mu_a{0.0}, mu_s{0.0};
   Spectrum<N> mu_a_Le{0.0};  // Σ mu_a,i L_e,i
-  int media = 0;             // how many media contribute
-  std::array<double, kMaxMedia> g{};
-  std::array<Spectrum<N>, kMaxMedia> mu_s_i{};  // each medium's scattering coefficient
+  int lobes = 0;             // how many different g the media present have
+  std::array<double, kMaxPhaseLobes> g{};
+  std::array<Spectrum<N>, kMaxPhaseLobes> mu_s_i{};  // each lobe's scattering coefficient
   Spectrum<N> mu_t() const { return mu_a + mu_s; }
 };
 
 // The density (the factor on sigma_a, sigma_s) of `medium` at x, where its object's F is F.
 double medium_density(const Medium& medium, const Vec3& x, double F);
 
-// Calls f(medium index, density) for each medium present at x (at most kMaxMediaAtPoint), seen
-// from `inside`, the solid object the point is in (-1: none).
+// Calls f(medium index, density) for each medium present at x, seen from `inside`, the solid
+// object the point is in (-1: none), in the order of the scene's field objects. In the field,
+// a scene with a member grid (member_grid.h) looks only at the objects listed for x's cell.
 template <MediumHolders S, class F>
 void for_each_medium_at(const S& scene, const Vec3& x, int inside, F&& f) {
   if (inside >= 0) {
@@ -52,17 +59,23 @@ void for_each_medium_at(const S& scene, const Vec3& x, int inside, F&& f) {
     if (d > 0) f(obj.medium, d);
     return;
   }
-  int count = 0;
-  for (int i : scene.field_objects) {
+  auto visit = [&](int i) {
     const auto& obj = scene.objects[i];
-    if (!obj.bounds.contains(x)) continue;
+    if (!obj.bounds.contains(x)) return;
     const double F_x = evaluate(obj.tape, x);
-    if (F_x <= 0) continue;
+    if (F_x <= 0) return;
     const double d = medium_density(scene.media[obj.medium], x, F_x);
-    if (d <= 0) continue;
-    f(obj.medium, d);
-    if (++count == kMaxMediaAtPoint) return;
+    if (d > 0) f(obj.medium, d);
+  };
+  if constexpr (requires { scene.field_grid; }) {
+    const MemberGrid& grid = scene.field_grid;
+    if (!grid.begin.empty()) {
+      for (const std::int32_t k : members_at(grid, x))
+        if (grid.bounds[k].contains(x)) visit(scene.field_objects[k]);
+      return;
+    }
   }
+  for (int i : scene.field_objects) visit(i);
 }
 
 namespace medium_field_detail {
@@ -84,20 +97,30 @@ void add_medium(const MediumCoefficients<N>& c, double density, const Vec3& x, S
 }  // namespace medium_field_detail
 
 // The coefficients at x seen from `inside`, with each medium's coefficients at the path's
-// channels in `coefficients` (indexed as scene.media), written into m. Only the first m.media
+// channels in `coefficients` (indexed as scene.media), written into m. Only the first m.lobes
 // entries of m's per-medium arrays are set: filling a point in place, rather than returning a
 // fresh one, spares a tracker that looks up many points the copy and clearing of those arrays.
 template <int N, MediumHolders S>
 void medium_at(const S& scene, const std::vector<MediumCoefficients<N>>& coefficients,
                const Vec3& x, int inside, MediumPoint<N>& m) {
   m.mu_a = m.mu_s = m.mu_a_Le = Spectrum<N>(0.0);
-  m.media = 0;
+  m.lobes = 0;
   for_each_medium_at(scene, x, inside, [&](int medium, double density) {
     const MediumCoefficients<N>& c = coefficients[medium];
     medium_field_detail::add_medium(c, density, x, m.mu_a, m.mu_s, m.mu_a_Le);
-    m.g[m.media] = scene.media[medium].g;
-    m.mu_s_i[m.media] = c.sigma_s * density;
-    ++m.media;
+    const double g = scene.media[medium].g;
+    int lobe = 0;
+    while (lobe < m.lobes && m.g[lobe] != g) ++lobe;
+    if (lobe == m.lobes) {
+      if (lobe == kMaxPhaseLobes)
+        throw std::logic_error(
+            "more different phase anisotropies at a point than "
+            "kMaxPhaseLobes: the scene was not checked (compile.h)");
+      m.g[lobe] = g;
+      m.mu_s_i[lobe] = Spectrum<N>(0.0);
+      ++m.lobes;
+    }
+    m.mu_s_i[lobe] += c.sigma_s * density;
   });
 }
 
@@ -159,30 +182,64 @@ bool add_span(MediumIntervals& m, double a, double b);
 bool add_object_spans(const Tape& tape, const Box& bounds, const Ray& ray, double t0, double t1,
                       MediumIntervals& m);
 
-template <MediumHolders S>
-MediumIntervals field_medium_intervals(const S& scene, const Ray& ray, double t_min, double t_max) {
-  MediumIntervals m;
-  for (int i : scene.field_objects) {
-    const auto& obj = scene.objects[i];
-    if (!add_object_spans(obj.tape, obj.bounds, ray, t_min, t_max, m)) {
-      // More stretches than kMax (a very wiggly surface): track the whole ray; the lookups
-      // find no medium where there is none.
-      m.count = 1;
-      m.spans[0] = {t_min, t_max};
-      return m;
-    }
+// The field objects whose stretches a walk has added: the few that the leaves crossed so far
+// list. When it is full it starts again; adding an object's stretches twice changes nothing.
+struct SpannedObjects {
+  static constexpr int kMax = 64;
+  int count = 0;
+  bool restarted = false;
+  std::array<std::int32_t, kMax> ids;
+  bool contains(std::int32_t id) const {
+    for (int i = 0; i < count; ++i)
+      if (ids[i] == id) return true;
+    return false;
   }
-  return m;
+};
+
+// Drops the spans that end at or before t: a walk past t never looks at them again.
+void drop_spans_before(MediumIntervals& m, double t);
+
+// Adds to `spans` the stretches of [t0, t1] past `a` where the listed field objects (indices
+// into scene.field_objects) that the ray meets in the leaf's stretch [a, b] and that are not
+// yet in `spanned` have F > 0. Each object's roots are searched over the whole [t0, t1],
+// whichever leaf first lists it, so they do not depend on the leaves. False when they do not fit
+// (then the walk takes the leaf's whole stretch with a minorant of 0, which holds everywhere);
+// `changed` says whether spans changed.
+template <MediumHolders S>
+bool add_leaf_spans(const S& scene, std::span<const std::int32_t> listed, const Ray& ray, double t0,
+                    double t1, double a, double b, MediumIntervals& spans, SpannedObjects& spanned,
+                    bool& changed) {
+  for (const std::int32_t k : listed) {
+    const auto& obj = scene.objects[scene.field_objects[k]];
+    double from = a, to = b;  // objects the ray does not meet in this leaf can wait
+    if (!clip_ray(obj.bounds, ray, from, to) || spanned.contains(k)) continue;
+    MediumIntervals own;
+    if (!add_object_spans(obj.tape, obj.bounds, ray, t0, t1, own)) return false;
+    for (int i = 0; i < own.count; ++i) {
+      if (own.spans[i].t1 <= a) continue;
+      if (!add_span(spans, own.spans[i].t0, own.spans[i].t1)) {
+        drop_spans_before(spans, a);
+        if (!add_span(spans, own.spans[i].t0, own.spans[i].t1)) return false;
+      }
+      changed = true;
+    }
+    if (spanned.count == SpannedObjects::kMax) {
+      spanned.count = 0;
+      spanned.restarted = true;
+    }
+    spanned.ids[spanned.count++] = k;
+  }
+  return true;
 }
 
 // Calls f(const MajorantSegment<N>&) for the majorant segments covering the media along the ray
 // in [t_min, t_max], in order, from the leaves of the scene's majorant octree (octree.h) for
 // `inside` (-1: the field; else that solid object), each channel taking its bin's bounds. Where
 // no medium can be there is a gap: in the field, the leaves' stretches are clipped to where an
-// object's F > 0 (field_medium_intervals), which the octree's minorants rely on, except in
-// leaves that an object fills (no surface crosses them), so a walk that stays in such leaves
-// finds no roots; inside a solid the ray never leaves the object. Neighbouring leaves with
-// identical bounds become one segment.
+// object's F > 0 (add_leaf_spans, from the objects each leaf lists), which the octree's
+// minorants rely on, except in leaves that an object fills (no surface crosses them), so a walk
+// that stays in such leaves finds no roots; inside a solid the ray never leaves the object.
+// Neighbouring leaves with identical bounds become one segment.
 // f returns false to stop the walk. The ray direction must be unit length.
 template <int N, MediaScene S, class F>
 void walk_majorant_segments(const S& scene, const Channels<N>& ch, const Ray& ray, double t_min,
@@ -191,12 +248,13 @@ void walk_majorant_segments(const S& scene, const Channels<N>& ch, const Ray& ra
   // at(): a scene whose octrees were never built fails loudly rather than reading past the end.
   const MajorantOctree& tree = inside >= 0 ? scene.solid_octrees.at(inside) : scene.field_octree;
   if (tree.nodes.empty()) return;
-  // In the field, the objects' spans are found (by root finding) only once the walk meets a
-  // leaf that an object's surface may cross: a walk within filled leaves needs none.
+  // In the field, an object's spans are found (by root finding) only once the walk meets a
+  // leaf that lists it and that an object's surface may cross: a walk within filled leaves
+  // needs none.
   MediumIntervals spans;
-  bool have_spans = inside >= 0;
+  SpannedObjects spanned;
   double t0 = t_min, t1 = t_max;
-  if (have_spans) {
+  if (inside >= 0) {
     spans.count = 1;
     spans.spans[0] = {t_min, t_max};
   } else if (!clip_ray(tree.box, ray, t0, t1) || !(t1 > t0)) {
@@ -229,12 +287,18 @@ void walk_majorant_segments(const S& scene, const Channels<N>& ch, const Ray& ra
       mu_c[c] = lo[ch.bin[c]];
     }
     if (tree.nodes[node].filled) return emit(a, b, mu_bar, mu_c);
-    if (!have_spans) {
-      spans = field_medium_intervals(scene, ray, t0, t1);
-      have_spans = true;
+    if (inside < 0) {
+      bool changed = false;
+      if (!tree.has_members() || !add_leaf_spans(scene, tree.leaf_members(node), ray, t0, t1, a, b,
+                                                 spans, spanned, changed))
+        return emit(a, b, mu_bar, Spectrum<N>(0.0));
+      if (changed) span = 0;
     }
     while (span < spans.count && spans.spans[span].t1 <= a) ++span;
-    if (span == spans.count) return false;
+    // Past the last span: done, unless leaves ahead may list objects not searched yet.
+    if (span == spans.count)
+      return inside < 0 &&
+             (spanned.restarted || size_t(spanned.count) < scene.field_objects.size());
     if (spans.spans[span].t0 >= b) return true;
     for (int k = span; k < spans.count && spans.spans[k].t0 < b; ++k)
       if (!emit(std::max(a, spans.spans[k].t0), std::min(b, spans.spans[k].t1), mu_bar, mu_c))
@@ -249,7 +313,7 @@ void walk_majorant_segments(const S& scene, const Channels<N>& ch, const Ray& ra
 template <int N>
 Spectrum<N> phase_value(const MediumPoint<N>& m, double cos_theta) {
   Spectrum<N> p(0.0);
-  for (int i = 0; i < m.media; ++i) p += m.mu_s_i[i] * hg_phase(cos_theta, m.g[i]);
+  for (int i = 0; i < m.lobes; ++i) p += m.mu_s_i[i] * hg_phase(cos_theta, m.g[i]);
   for (int c = 0; c < N; ++c) p[c] = m.mu_s[c] > 0 ? p[c] / m.mu_s[c] : 0.0;
   return p;
 }
@@ -258,9 +322,9 @@ Spectrum<N> phase_value(const MediumPoint<N>& m, double cos_theta) {
 template <int N>
 double phase_pdf(const MediumPoint<N>& m, double cos_theta) {
   const double total = m.mu_s.sum();
-  if (m.media == 1 || total <= 0) return hg_phase(cos_theta, m.g[0]);
+  if (m.lobes == 1 || total <= 0) return hg_phase(cos_theta, m.g[0]);
   double pdf = 0;
-  for (int i = 0; i < m.media; ++i) pdf += m.mu_s_i[i].sum() / total * hg_phase(cos_theta, m.g[i]);
+  for (int i = 0; i < m.lobes; ++i) pdf += m.mu_s_i[i].sum() / total * hg_phase(cos_theta, m.g[i]);
   return pdf;
 }
 
@@ -269,7 +333,7 @@ double phase_pdf(const MediumPoint<N>& m, double cos_theta) {
 template <int N>
 Vec3 sample_phase(const MediumPoint<N>& m, const Vec3& dir, double u0, double u1, double u2,
                   Spectrum<N>& weight, double& pdf) {
-  if (m.media <= 1) {
+  if (m.lobes <= 1) {
     const Vec3 w = sample_hg(dir, m.g[0], u1, u2);
     weight = Spectrum<N>(1.0);
     pdf = hg_phase(dot(dir, w), m.g[0]);
@@ -277,9 +341,9 @@ Vec3 sample_phase(const MediumPoint<N>& m, const Vec3& dir, double u0, double u1
   }
   // One-sample mixture: pick a lobe ∝ its share of mu_s, weight by the exact mixture.
   const double total = m.mu_s.sum();
-  int pick = m.media - 1;
+  int pick = m.lobes - 1;
   double acc = 0;
-  for (int i = 0; i < m.media; ++i) {
+  for (int i = 0; i < m.lobes; ++i) {
     acc += m.mu_s_i[i].sum() / total;
     if (u0 < acc) {
       pick = i;

@@ -65,17 +65,18 @@ bool density_range(const Member& m, const Box& box, bool only_inside, double& lo
 // margin far above round-off keeps the bounds conservative.
 constexpr double kRoundOff = 1e-12;
 
-// Bounds of mu_t over a box, the sum over members of sigma_t times their density range there,
-// into out[0, bins) (majorants) and out[bins, 2 bins) (minorants). False if no medium can be
-// in the box. `filled`: some member's F > 0 over the whole box, within its bounds.
-bool interval_bounds(const std::vector<Member>& members, const Box& box, bool solid, int bins,
-                     double* out, bool& filled) {
+// Bounds of mu_t over a box, the sum over the listed members of sigma_t times their density
+// range there, into out[0, bins) (majorants) and out[bins, 2 bins) (minorants). False if no
+// medium can be in the box. `filled`: some member's F > 0 over the whole box, within its bounds.
+bool interval_bounds(const std::vector<Member>& all, std::span<const std::int32_t> listed,
+                     const Box& box, bool solid, int bins, double* out, bool& filled) {
   std::fill(out, out + 2 * bins, 0.0);
   // Where one member alone may be present, the clipped walk sees only its inside; where several
   // may, a point inside one of them can be outside another.
   int present = 0;
   filled = false;
-  for (const Member& m : members) {
+  for (const std::int32_t i : listed) {
+    const Member& m = all[i];
     const Box b = intersect(m.object->bounds, box);
     if (b.empty()) continue;
     const Interval F = evaluate(*m.object->tape, b);
@@ -83,7 +84,8 @@ bool interval_bounds(const std::vector<Member>& members, const Box& box, bool so
     filled = filled || (F.lo > 0 && b.lo == box.lo && b.hi == box.hi);
   }
   bool any = false;
-  for (const Member& m : members) {
+  for (const std::int32_t i : listed) {
+    const Member& m = all[i];
     double lo = 0, hi = 0;
     // A density bounded by 0 (a cloud eroded away near its surface) is no medium either.
     if (!density_range(m, box, solid || present == 1, lo, hi) || !(hi > 0)) continue;
@@ -134,7 +136,23 @@ struct Grown {
   std::vector<double> bounds;  // 2 bins per node, as MajorantOctree::bounds
   std::vector<Vec3> centers;
   std::vector<int> levels;
+  // Per node, the members whose bounds meet its box, ascending: a child looks only at its
+  // parent's, so a build does not look at every member in every node.
+  std::vector<std::vector<std::int32_t>> lists;
 };
+
+// The members of `parent` whose bounds meet the box, grown by a millionth of its size: a
+// child's faces are computed from its center, a rounding off the parent's mid-plane, and a
+// point's descent (members_at) or a ray's stretch may lie on either side of that plane.
+std::vector<std::int32_t> members_meeting(const std::vector<Member>& all,
+                                          std::span<const std::int32_t> parent, const Box& box) {
+  const Vec3 margin = box.extent() * 1e-6;
+  const Box grown{box.lo - margin, box.hi + margin};
+  std::vector<std::int32_t> out;
+  for (const std::int32_t i : parent)
+    if (!intersect(all[i].object->bounds, grown).empty()) out.push_back(i);
+  return out;
+}
 
 // Undoes the splits that do not pay for themselves, bottom up, and compacts the tree. The cost
 // of a ray crossing a leaf is one step plus kOctreeLookupCost per expected null collision there,
@@ -171,6 +189,7 @@ Grown prune(Grown g, const MajorantOctree& tree) {
   copy_bounds(0);
   out.centers.push_back(g.centers[0]);
   out.levels.push_back(0);
+  out.lists.push_back(std::move(g.lists[0]));
   std::vector<size_t> from{0};
   for (size_t i = 0; i < out.nodes.size(); ++i) {
     const std::int32_t old_children = g.nodes[from[i]].children;
@@ -182,6 +201,7 @@ Grown prune(Grown g, const MajorantOctree& tree) {
       copy_bounds(c);
       out.centers.push_back(g.centers[c]);
       out.levels.push_back(g.levels[c]);
+      out.lists.push_back(std::move(g.lists[c]));
       from.push_back(c);
     }
   }
@@ -216,15 +236,15 @@ struct MemberObject {
 };
 struct MemberScene {
   std::span<const Medium> media;
-  std::vector<MemberObject> objects;
-  std::vector<int> field_objects;
+  std::span<const MemberObject> objects;
+  std::span<const std::int32_t> field_objects;  // a leaf's members, for the field
 };
 
 // Progress: the interval phase reports levels done as the first half, the sampling pass leaves
 // done as the second.
-void sample_bounds(const MemberScene& scene, int inside, const OctreeSettings& settings,
-                   const std::vector<std::vector<double>>& sigma_t, MajorantOctree& tree, Grown& g,
-                   BuildWatch& watch) {
+void sample_bounds(std::span<const Medium> media, std::span<const MemberObject> objects, bool solid,
+                   const OctreeSettings& settings, const std::vector<std::vector<double>>& sigma_t,
+                   MajorantOctree& tree, Grown& g, BuildWatch& watch) {
   // At most kOctreeSampleBudget points in all: a deep tree gets fewer per leaf (at depth 16 with
   // 4 096 per leaf the pass had not finished after 60 s).
   size_t leaves = 0;
@@ -242,6 +262,8 @@ void sample_bounds(const MemberScene& scene, int inside, const OctreeSettings& s
     watch.report(0.5 + 0.5 * double(leaves_done.fetch_add(1)) / double(leaves));
     const Box box = box_of(g.centers[i], tree.half[g.levels[i]]);
     Rng rng(seed, i);
+    const MemberScene scene{media, objects, g.lists[i]};
+    const int inside = solid ? 0 : -1;
     double* out = &g.bounds[2 * bins * i];
     const std::vector<double> interval(out, out + 2 * bins);
     std::fill(out, out + bins, 0.0);
@@ -310,15 +332,22 @@ MajorantOctree build_majorant_octree(std::span<const Medium> media,
   tree.half[0] = tree.box.extent() * 0.5;
   for (int l = 1; l <= kOctreeMaxDepth; ++l) tree.half[l] = tree.half[l - 1] * 0.5;
 
-  auto make_node = [&](const Vec3& center, const Vec3& half, double* bounds) {
+  auto make_node = [&](const Vec3& center, const Vec3& half, double* bounds,
+                       std::span<const std::int32_t> parent_list, std::vector<std::int32_t>& list) {
+    const Box box = box_of(center, half);
+    list = members_meeting(members, parent_list, box);
     OctreeNode n;
-    n.empty = !interval_bounds(members, box_of(center, half), solid, bins, bounds, n.filled);
+    n.empty = !interval_bounds(members, list, box, solid, bins, bounds, n.filled);
     return n;
   };
   // Node centers are computed as the walk computes them, so both see the same boxes.
   Grown g;
   g.bounds.resize(2 * bins);
-  g.nodes.push_back(make_node(tree.box.center(), tree.half[0], g.bounds.data()));
+  std::vector<std::int32_t> everyone(members.size());
+  for (size_t i = 0; i < members.size(); ++i) everyone[i] = static_cast<std::int32_t>(i);
+  g.lists.emplace_back();
+  g.nodes.push_back(
+      make_node(tree.box.center(), tree.half[0], g.bounds.data(), everyone, g.lists[0]));
   g.centers.push_back(tree.box.center());
   g.levels.push_back(0);
   const int max_depth = std::clamp(settings.depth, 0, kOctreeMaxDepth);
@@ -354,6 +383,7 @@ MajorantOctree build_majorant_octree(std::span<const Medium> media,
     g.bounds.resize(2 * bins * g.nodes.size());
     g.centers.resize(g.nodes.size());
     g.levels.resize(g.nodes.size(), level + 1);
+    g.lists.resize(g.nodes.size());
     tbb::parallel_for(size_t{0}, split.size(), [&](size_t s) {
       const size_t parent = split[s].node, first = end + 8 * s;
       g.nodes[parent].children = static_cast<std::int32_t>(first);
@@ -361,7 +391,8 @@ MajorantOctree build_majorant_octree(std::span<const Medium> media,
         Vec3 c = g.centers[parent];
         for (int a = 0; a < 3; ++a) c[a] += (k >> a & 1) ? child_half[a] : -child_half[a];
         g.centers[first + k] = c;
-        g.nodes[first + k] = make_node(c, child_half, &g.bounds[2 * bins * (first + k)]);
+        g.nodes[first + k] = make_node(c, child_half, &g.bounds[2 * bins * (first + k)],
+                                       g.lists[parent], g.lists[first + k]);
       }
     });
     begin = end;
@@ -370,13 +401,19 @@ MajorantOctree build_majorant_octree(std::span<const Medium> media,
   g = prune(std::move(g), tree);
   tree.depth = *std::max_element(g.levels.begin(), g.levels.end());
   if (settings.sampled) {
-    MemberScene scene{media, {}, {}};
-    for (size_t i = 0; i < holders.size(); ++i) {
-      scene.objects.push_back({*holders[i].tape, holders[i].bounds, holders[i].medium});
-      if (!solid) scene.field_objects.push_back(static_cast<int>(i));
-    }
-    sample_bounds(scene, solid ? 0 : -1, settings, sigma_t, tree, g, watch);
+    std::vector<MemberObject> objects;
+    for (const OctreeMember& h : holders) objects.push_back({*h.tape, h.bounds, h.medium});
+    sample_bounds(media, objects, solid, settings, sigma_t, tree, g, watch);
     if (watch.cancelled()) return tree;
+  }
+  if (!solid) {
+    tree.member_begin.reserve(g.nodes.size() + 1);
+    for (size_t i = 0; i < g.nodes.size(); ++i) {
+      tree.member_begin.push_back(static_cast<std::uint32_t>(tree.members.size()));
+      if (g.nodes[i].children < 0 && !g.nodes[i].empty)
+        tree.members.insert(tree.members.end(), g.lists[i].begin(), g.lists[i].end());
+    }
+    tree.member_begin.push_back(static_cast<std::uint32_t>(tree.members.size()));
   }
   tree.nodes = std::move(g.nodes);
   tree.bounds = std::move(g.bounds);

@@ -81,6 +81,11 @@ struct MajorantOctree {
   double majorant_scale = 1;  // OctreeSettings::majorant_scale, applied by the walk
   // Per node, `bins` majorants of mu_t (unscaled), then `bins` minorants.
   std::vector<double> bounds;
+  // The field's tree only: per non-empty leaf, the members (indices into the build's list,
+  // ascending) whose bounds meet the leaf's box: all that a ray's root finding there need look
+  // at (medium_field.h). Node i's are members[member_begin[i], member_begin[i + 1]).
+  std::vector<std::uint32_t> member_begin;
+  std::vector<std::int32_t> members;
   int depth = 0;  // deepest level reached
   double build_seconds = 0;
   uint64_t sampled_points = 0;  // points looked up by the sampling pass (source "sample")
@@ -89,7 +94,12 @@ struct MajorantOctree {
   const double* mu_c(std::size_t node) const { return &bounds[2 * bins * node + bins]; }
   std::size_t bytes() const {
     return sizeof(MajorantOctree) + nodes.size() * sizeof(OctreeNode) +
-           bounds.size() * sizeof(double);
+           bounds.size() * sizeof(double) + member_begin.size() * sizeof(std::uint32_t) +
+           members.size() * sizeof(std::int32_t);
+  }
+  bool has_members() const { return !member_begin.empty(); }
+  std::span<const std::int32_t> leaf_members(std::int32_t node) const {
+    return {members.data() + member_begin[node], members.data() + member_begin[node + 1]};
   }
 };
 

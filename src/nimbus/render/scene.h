@@ -10,6 +10,7 @@
 #include "nimbus/frep/tape.h"
 #include "nimbus/math/box.h"
 #include "nimbus/media/medium.h"
+#include "nimbus/media/member_grid.h"
 #include "nimbus/media/octree.h"
 #include "nimbus/render/camera.h"
 #include "nimbus/render/film.h"
@@ -100,6 +101,7 @@ struct Scene {
   std::vector<int> field_objects;  // index-matched objects (surface none) holding a medium
   // Majorants and minorants (build_majorant_octrees): of the field, and inside each solid
   // object holding a medium (indexed by object; empty for the others).
+  MemberGrid field_grid;  // which field objects may hold a point (index into field_objects)
   MajorantOctree field_octree;
   SolidOctrees solid_octrees;
   SurfaceIndex surfaces;  // what `intersect` and `occluded` search (finish_scene builds it)

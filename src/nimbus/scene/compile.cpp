@@ -96,7 +96,7 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
   for (const MediumDesc& md : desc.media) scene.media.push_back(compile_medium(md, read));
   if (inputs) *inputs = std::move(read);
 
-  int field_objects = 0;  // finish_scene lists them; here they are counted for the message
+  std::vector<double> field_g;                  // the different anisotropies of index-matched media
   std::vector<const ObjectDesc*> object_descs;  // of each compiled object, for messages
   for (const ObjectDesc& od : desc.objects) {
     SceneObject obj;
@@ -112,12 +112,16 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
     obj.bounds = b.box;
     obj.surface = compile_surface(od.surface);
     obj.medium = medium;
-    if (obj.surface.type == Surface::Type::None && obj.medium >= 0) {
-      if (++field_objects > kMaxMediaAtPoint)
-        throw SceneError(
-            fmt::format("{}: {}/medium: at most {} index-matched (surface none) "
-                        "medium objects are supported",
-                        desc.source, od.json_path, kMaxMediaAtPoint));
+    const double g = obj.medium >= 0 ? scene.media[obj.medium].g : 0;
+    if (obj.surface.type == Surface::Type::None && obj.medium >= 0 &&
+        std::find(field_g.begin(), field_g.end(), g) == field_g.end()) {
+      if (field_g.size() == size_t(kMaxPhaseLobes))
+        throw SceneError(fmt::format(
+            "{}: {}/medium: medium \"{}\" has a {}th different phase anisotropy (g {:g}) among "
+            "the index-matched (surface none) media; at most {} are supported",
+            desc.source, od.json_path, desc.media[obj.medium].name, kMaxPhaseLobes + 1, g,
+            kMaxPhaseLobes));
+      field_g.push_back(g);
     }
     scene.objects.push_back(std::move(obj));
     object_descs.push_back(&od);
@@ -153,10 +157,19 @@ void finish_scene(Scene& scene, const BuildMonitor& monitor) {
     if (obj.surface.type == Surface::Type::None && obj.medium >= 0)
       scene.field_objects.push_back(static_cast<int>(i));
   }
-  if (scene.field_objects.size() > size_t(kMaxMediaAtPoint))
+  std::vector<double> field_g;
+  for (int i : scene.field_objects) {
+    const double g = scene.media[scene.objects[i].medium].g;
+    if (std::find(field_g.begin(), field_g.end(), g) == field_g.end()) field_g.push_back(g);
+  }
+  if (field_g.size() > size_t(kMaxPhaseLobes))
     throw std::invalid_argument(
-        fmt::format("{} index-matched medium objects; at most {} are supported",
-                    scene.field_objects.size(), kMaxMediaAtPoint));
+        fmt::format("the index-matched media have {} different phase anisotropies g; at most {} "
+                    "are supported",
+                    field_g.size(), kMaxPhaseLobes));
+  std::vector<Box> field_bounds;
+  for (int i : scene.field_objects) field_bounds.push_back(scene.objects[i].bounds);
+  scene.field_grid = build_member_grid(field_bounds);
   if (!all.empty()) scene.scale = length(all.extent());
   scene.surfaces = build_surface_index(scene.objects, scene.lights);
   complete_spectra(scene);

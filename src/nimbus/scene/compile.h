@@ -35,8 +35,8 @@ int compiled_medium(const ObjectDesc& object);
 // What a scene needs before it renders, derived from its objects, media, lights and settings:
 // the list of index-matched medium objects, the scene's size, every colour's spectrum and the
 // majorant octrees. compile_scene calls it; a scene built in code calls it once it is complete
-// (and again after changing any of those). Throws std::invalid_argument for more than
-// kMaxMediaAtPoint index-matched medium objects.
+// (and again after changing any of those). Throws std::invalid_argument when the index-matched
+// media have more than kMaxPhaseLobes different phase anisotropies (medium_field.h).
 void finish_scene(Scene& scene, const BuildMonitor& monitor = {});
 
 }  // namespace nimbus

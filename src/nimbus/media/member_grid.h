@@ -1,0 +1,53 @@
+#pragma once
+// Which index-matched medium objects may hold a point (issue 26): a uniform grid over their
+// bounds whose cells list, in ascending order, the objects whose bounds meet them. A point's
+// lookup (medium_field.h) looks at its cell's objects only, so its cost follows the objects
+// near the point, not the number in the scene. The grid has about kMemberGridCellsPerObject
+// cells per object, coarser where the lists would exceed kMemberGridMaxEntries in all.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "nimbus/math/box.h"
+
+namespace nimbus {
+
+inline constexpr double kMemberGridCellsPerObject = 16;
+inline constexpr std::size_t kMemberGridMaxEntries = std::size_t{1} << 24;
+
+struct MemberGrid {
+  Box box;  // the union of the objects' bounds; empty: no objects
+  std::array<int, 3> cells{0, 0, 0};
+  Vec3 inv_cell{0, 0, 0};            // cells per unit length, per axis
+  std::vector<std::uint32_t> begin;  // cell c's objects: members[begin[c], begin[c + 1])
+  std::vector<std::int32_t> members;
+  std::vector<Box> bounds;  // object i's bounds, together: a lookup tests them before the objects
+
+
+  std::size_t bytes() const {
+    return sizeof(MemberGrid) + begin.size() * sizeof(std::uint32_t) +
+           members.size() * sizeof(std::int32_t) + bounds.size() * sizeof(Box);
+  }
+  // The cell along axis k of coordinate v, clamped into the grid. Monotonic in v, so the
+  // cells of an object's bounds hold every point inside them.
+  int cell(int k, double v) const {
+    const double c = (v - box.lo[k]) * inv_cell[k];
+    return c <= 0 ? 0 : c >= cells[k] - 1 ? cells[k] - 1 : static_cast<int>(c);
+  }
+};
+
+// The grid over `bounds` (object i's conservative bounds).
+MemberGrid build_member_grid(std::span<const Box> bounds);
+
+// The objects whose bounds may hold x, ascending (none outside the grid's box).
+inline std::span<const std::int32_t> members_at(const MemberGrid& grid, const Vec3& x) {
+  if (!grid.box.contains(x)) return {};
+  const std::size_t c =
+      (std::size_t(grid.cell(2, x.z)) * grid.cells[1] + grid.cell(1, x.y)) * grid.cells[0] +
+      grid.cell(0, x.x);
+  return {grid.members.data() + grid.begin[c], grid.members.data() + grid.begin[c + 1]};
+}
+
+}  // namespace nimbus
