@@ -9,8 +9,11 @@ and the table gains the ratio A/B of samples per second.
   objects: N diffuse spheres (or free forms of four perturbations, --freeform) on a square grid
            over a floor, lit by a sun and a sky, 96 x 64 pixels, 4 spp.
   lights:  N sphere lights on a square grid over a diffuse floor, 64 x 64 pixels, 4 spp.
+  puffs:   N index-matched spheres of one medium (constant density, or --cloud) on a square
+           grid over a floor, each overlapping its neighbours, 96 x 64 pixels, 4 spp.
 
-Usage: tools/bench_scale.py objects|lights N[,N...] ROUNDS NIMBUS [NIMBUS_B] [--freeform]
+Usage: tools/bench_scale.py objects|lights|puffs N[,N...] ROUNDS NIMBUS [NIMBUS_B] [--freeform]
+       [--cloud]
 """
 import json
 import math
@@ -69,6 +72,24 @@ def lights_scene(n):
             "objects": [{"shape": "floor", "surface": {"type": "diffuse", "albedo": 0.5}}]}
 
 
+def puffs_scene(n, cloud):
+    points, step = grid(n, 4.0)
+    r = 0.7 * step  # a puff reaches into its neighbours
+    medium = {"sigma_a": 0.1 / r, "sigma_s": 2 / r, "phase": {"type": "hg", "g": 0.6}}
+    if cloud:
+        medium["density"] = {"type": "cloud", "frequency": 1 / r}
+    objects = [{"shape": "floor", "surface": {"type": "diffuse", "albedo": 0.5}}]
+    objects += [{"shape": {"type": "sphere", "center": [x, r, z], "radius": r},
+                 "surface": {"type": "none"}, "medium": "puff"} for x, z in points]
+    return {"film": {"width": 96, "height": 64},
+            "camera": {"from": [0, 7, 9], "to": [0, 0, 0], "fov": 50},
+            "integrator": {"spp": 4, "max_depth": 4},
+            "lights": [{"type": "directional", "direction": [-0.3, -1, -0.4], "irradiance": 2},
+                       {"type": "environment", "radiance": 0.3}],
+            "shapes": {"floor": {"type": "box", "min": [-6, -1, -6], "max": [6, 0, 6]}},
+            "media": {"puff": medium}, "objects": objects}
+
+
 def run(nimbus, scene, out):
     """Samples per second, wall seconds and peak resident MiB of one render."""
     stats = os.path.join(out, "stats.json")
@@ -86,18 +107,21 @@ def run(nimbus, scene, out):
 
 def main():
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
-    freeform = "--freeform" in sys.argv
+    freeform, cloud = "--freeform" in sys.argv, "--cloud" in sys.argv
     kind, counts, rounds = args[0], [int(n) for n in args[1].split(",")], int(args[2])
     binaries = args[3:]
     out = tempfile.mkdtemp()
-    print(f"{kind}{' (free forms)' if freeform else ''}: median of {rounds}, one thread")
+    variant = " (free forms)" if freeform else " (cloud density)" if cloud else ""
+    print(f"{kind}{variant}: median of {rounds}, one thread")
     header = "| N | " + " | ".join(f"samples/s {'AB'[i]} | wall s {'AB'[i]} | peak MiB {'AB'[i]}"
                                     for i in range(len(binaries)))
     print(header + (" | A/B samples/s |" if len(binaries) == 2 else " |"))
     for n in counts:
         scene = os.path.join(out, f"{kind}_{n}.json")
         with open(scene, "w") as f:
-            json.dump(objects_scene(n, freeform) if kind == "objects" else lights_scene(n), f)
+            json.dump({"objects": lambda: objects_scene(n, freeform),
+                       "lights": lambda: lights_scene(n),
+                       "puffs": lambda: puffs_scene(n, cloud)}[kind](), f)
         results = [[] for _ in binaries]
         for _ in range(rounds):
             for i, b in enumerate(binaries):

@@ -7,8 +7,10 @@
 #   tools/fuzz.sh [--vdb] [SECONDS] [JOBS]   fuzz for SECONDS (default 60) with JOBS processes
 #                                            (default 1); new inputs go to BUILD/fuzz-corpus (or
 #                                            BUILD/vdb-fuzz-corpus)
-#   tools/fuzz.sh [--vdb] --runs N           N inputs from a fixed seed, new inputs discarded:
-#                                            the deterministic check that tools/sanitize.sh runs
+#   tools/fuzz.sh [--vdb] --runs N [JOBS]    N inputs in all from fixed seeds (JOBS processes,
+#                                            default 1, process k with seed k and N / JOBS
+#                                            inputs), new inputs discarded: the deterministic
+#                                            check that tools/sanitize.sh runs
 # A finding is written to BUILD/fuzz-findings/ and fails the script.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -35,10 +37,23 @@ mkdir -p "$build/fuzz-findings"
 options+=(-timeout=20 -rss_limit_mb=2048 -artifact_prefix="$build/fuzz-findings/"
   -print_final_stats=1)
 if [ "${1:-}" = "--runs" ]; then
+  jobs=${3:-1}
   scratch=$(mktemp -d)
   trap 'rm -rf "$scratch"' EXIT
-  "./$build/$target" "${options[@]}" -seed=1 -runs="$2" "$scratch" "$corpus"
-  exit
+  pids=()
+  for ((k = 1; k <= jobs; ++k)); do
+    mkdir "$scratch/$k"
+    # One log per process, shown in order once all are done.
+    "./$build/$target" "${options[@]}" -seed="$k" -runs="$(($2 / jobs))" "$scratch/$k" \
+      "$corpus" >"$scratch/$k.log" 2>&1 &
+    pids+=($!)
+  done
+  failed=0
+  for ((k = 1; k <= jobs; ++k)); do
+    wait "${pids[k - 1]}" || failed=1
+    cat "$scratch/$k.log"
+  done
+  exit "$failed"
 fi
 seconds=${1:-60}
 jobs=${2:-1}

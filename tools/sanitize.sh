@@ -24,6 +24,7 @@ repeats+=':Modes/MediaRender.SingleScattering*:Modes/SpectralRender.Chandrasekha
 repeats+=':Modes/SpectralRender.EmittingField*:Modes/SpectralRender.SingleScattering*'
 repeats+=':Modes/SpectralRender.EmissiveFurnace*'
 repeats+=':Modes/MediaRender.EmissiveFurnaceIsInEquilibrium/*Unbounded*'
+repeats+=':ManyMedia.OverlappingCopiesRenderAsTheirSum'
 filter="*:-$repeats"
 [ "${1:-}" = "--all" ] && filter='*'
 sanitized_tests() {
@@ -33,4 +34,4 @@ sanitized_tests() {
 phase "sanitized configure" bash tools/configure.sh sanitize
 phase "sanitized build" cmake --build build-sanitize -j"$(nproc)"
 phase "sanitized tests" sanitized_tests
-phase "fuzzing" bash tools/fuzz.sh --runs 200000
+phase "fuzzing" bash tools/fuzz.sh --runs 200000 "$(nproc)"
