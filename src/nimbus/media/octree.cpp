@@ -130,6 +130,12 @@ double mean_chord(const Vec3& half) {
   return 4 * half.x * half.y * half.z / (half.x * half.y + half.y * half.z + half.x * half.z);
 }
 
+// How many members a node lists past kOctreeMaxListed: what the walk's clip tests cost there
+// beyond a few objects (0 in any scene of at most that many media objects).
+double crowding(const std::vector<std::int32_t>& list) {
+  return list.size() > size_t(kOctreeMaxListed) ? double(list.size() - kOctreeMaxListed) : 0.0;
+}
+
 // The tree as built and the arrays that place its nodes, all in breadth-first order.
 struct Grown {
   std::vector<OctreeNode> nodes;
@@ -165,10 +171,11 @@ Grown prune(Grown g, const MajorantOctree& tree) {
   std::vector<double> cost(g.nodes.size());
   for (size_t i = g.nodes.size(); i-- > 0;) {
     OctreeNode& n = g.nodes[i];
-    const double leaf = n.empty
-                            ? 1.0
-                            : 1.0 + kOctreeLookupCost * null_rate(&g.bounds[2 * bins * i], bins) *
-                                        mean_chord(tree.half[g.levels[i]]);
+    const double leaf = n.empty ? 1.0
+                                : 1.0 +
+                                      kOctreeLookupCost * null_rate(&g.bounds[2 * bins * i], bins) *
+                                          mean_chord(tree.half[g.levels[i]]) +
+                                      kOctreeListedCost * crowding(g.lists[i]);
     cost[i] = leaf;
     if (n.children < 0) continue;
     double split = 0;
@@ -353,9 +360,10 @@ MajorantOctree build_majorant_octree(std::span<const Medium> media,
   const int max_depth = std::clamp(settings.depth, 0, kOctreeMaxDepth);
   size_t begin = 0, end = 1;
   const double interval_share = settings.sampled ? 0.5 : 1.0;
-  for (int level = 0; level < max_depth; ++level) {
+  // Levels past the requested depth split only nodes that list too many objects.
+  for (int level = 0; level < kOctreeMaxDepth; ++level) {
     if (watch.cancelled()) return tree;
-    watch.report(interval_share * level / max_depth);
+    watch.report(interval_share * std::min(1.0, double(level) / std::max(max_depth, 1)));
     const Vec3& half = tree.half[level];
     struct Candidate {
       double priority;
@@ -364,8 +372,9 @@ MajorantOctree build_majorant_octree(std::span<const Medium> media,
     std::vector<Candidate> split;
     for (size_t i = begin; i < end; ++i) {
       const double* b = &g.bounds[2 * bins * i];
-      if (wants_split(g.nodes[i], b, bins, half))
-        split.push_back({null_optical_depth(b, bins, half), i});
+      const bool crowded = !g.nodes[i].empty && crowding(g.lists[i]) > 0;
+      if ((level < max_depth && wants_split(g.nodes[i], b, bins, half)) || crowded)
+        split.push_back({null_optical_depth(b, bins, half) + crowding(g.lists[i]), i});
     }
     const size_t room = (kOctreeMaxNodes - g.nodes.size()) / 8;
     if (split.size() > room) {

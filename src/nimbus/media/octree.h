@@ -58,6 +58,12 @@ inline constexpr size_t kOctreeSampleBudget = size_t{1} << 24;
 // octree-depth experiment renders slower than a shallower one (at 16, depth 8 was 13 % slower
 // than depth 4).
 inline constexpr double kOctreeLookupCost = 4;
+// A field node listing more media objects than this is split further, past the requested depth
+// if need be, and the cost model charges each one past it kOctreeListedCost walk steps (a ray
+// crossing the leaf tests its box): the leaves stay short lists however many objects the
+// scene holds (issue 26), and scenes of at most this many media objects build as before.
+inline constexpr int kOctreeMaxListed = 8;
+inline constexpr double kOctreeListedCost = 0.5;
 
 struct OctreeNode {
   // The first of 8 contiguous children, child k in octant (k & 1: upper x, k & 2: upper y,
