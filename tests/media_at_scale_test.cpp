@@ -165,27 +165,10 @@ TEST(ManyMedia, WalksThroughThousandsOfPuffsBoundAndCoverTheMedium) {
 // Twenty-four index-matched unit spheres, one inside the other, each holding a medium of 1/24
 // the density, render as one sphere of the whole density: the media add.
 Scene stacked(int copies, double density, TrackingSettings::Mode mode) {
-  Scene scene;
-  scene.settings = {
-      8,    8,
-      1024, 31,
-      1000, test::tracking_settings(mode, TrackingSettings::Absorption::Collide, false, 4),
-      {},   RenderSettings::Sampler::Independent};
-  scene.camera = orthographic_camera({0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 2.1, 8, 8);
-  Medium m;
-  m.sigma_s = Rgb({1.0, 2.0, 3.0}) * density;
-  m.sigma_a = Rgb(1.0) * density;
-  m.g = 0.3;
-  scene.media.push_back(m);
+  Scene scene = test::bulb_in_medium(density, mode);  // as in MediaRenderLights
   for (int i = 0; i < copies; ++i)
     scene.objects.push_back(
         test::object_of(make_shape(QuadricNode{sphere({0, 0, 0}, 1)}), Surface::Type::None, 0));
-  Light bulb;  // inside the medium, as in MediaRenderLights
-  bulb.type = Light::Type::Sphere;
-  bulb.center = {0.2, 0.1, -0.1};
-  bulb.radius = 0.45;
-  bulb.emission = Rgb(3.0);
-  scene.lights.push_back(bulb);
   finish_scene(scene);
   return scene;
 }

@@ -480,26 +480,9 @@ TEST_P(MediaRender, SingleScatteringInAChromaticFieldMatchesQuadrature) {
 // scattering vertex samples the light and MIS weighs both. Issue 17: the solid's phase-sampled
 // hits got the MIS weight of the light sampling it skipped, and lost most of the light.
 Scene light_in_medium(Surface::Type surface, double density, TrackingSettings::Mode mode) {
-  Scene scene;
-  scene.settings = {
-      8,    8,
-      1024, 31,
-      1000, test::tracking_settings(mode, TrackingSettings::Absorption::Collide, false, 4),
-      {},   RenderSettings::Sampler::Independent};
-  scene.camera = orthographic_camera({0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 2.1, 8, 8);
-  Medium m;
-  m.sigma_s = Rgb({1.0, 2.0, 3.0}) * density;
-  m.sigma_a = Rgb(1.0) * density;
-  m.g = 0.3;
-  scene.media.push_back(m);
+  Scene scene = test::bulb_in_medium(density, mode);
   scene.objects.push_back(
       test::object_of(make_shape(QuadricNode{sphere({0, 0, 0}, 1)}), surface, 0, 1.0));
-  Light bulb;
-  bulb.type = Light::Type::Sphere;
-  bulb.center = {0.2, 0.1, -0.1};
-  bulb.radius = 0.45;
-  bulb.emission = Rgb(3.0);
-  scene.lights.push_back(bulb);
   test::finish_media(scene);
   return scene;
 }

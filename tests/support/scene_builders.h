@@ -46,6 +46,30 @@ inline TrackingSettings tracking_settings(TrackingSettings::Mode mode,
   return t;
 }
 
+// Issue 17's scene without its objects: an 8 × 8 orthographic view of the unit sphere's region
+// at 1 024 spp, lit by a sphere light inside the sphere, with media[0] a medium of `density`
+// (chromatic scattering, grey absorption, g 0.3). The caller adds the objects holding it.
+inline Scene bulb_in_medium(double density, TrackingSettings::Mode mode) {
+  Scene scene;
+  scene.settings = {8,    8,
+                    1024, 31,
+                    1000, tracking_settings(mode, TrackingSettings::Absorption::Collide, false, 4),
+                    {},   RenderSettings::Sampler::Independent};
+  scene.camera = orthographic_camera({0, 0, 4}, {0, 0, 0}, {0, 1, 0}, 2.1, 8, 8);
+  Medium m;
+  m.sigma_s = Rgb({1.0, 2.0, 3.0}) * density;
+  m.sigma_a = Rgb(1.0) * density;
+  m.g = 0.3;
+  scene.media.push_back(m);
+  Light bulb;
+  bulb.type = Light::Type::Sphere;
+  bulb.center = {0.2, 0.1, -0.1};
+  bulb.radius = 0.45;
+  bulb.emission = Rgb(3.0);
+  scene.lights.push_back(bulb);
+  return scene;
+}
+
 // Field objects, spectra and majorant octrees, as compile_scene derives them.
 inline void finish_media(Scene& scene) {
   finish_scene(scene);
