@@ -118,7 +118,8 @@ std::vector<Setting> make_settings() {
           [](auto& s) -> auto& { return s.tracking.majorant_scale; }),
       integer(
           "integrator.octree.depth", between(0, kOctreeMaxDepth),
-          "deepest level of the majorant octree; 0: one node over all media",
+          "deepest level of the majorant octree; 0: one node over all media (a node over more than "
+          "eight index-matched media objects splits further whatever the depth)",
           [](auto& s) -> auto& { return s.tracking.octree_depth; }),
       choice(
           "spectrum.mode", "spectrum mode", kSpectrumModeNames,
