@@ -59,9 +59,9 @@ void for_each_medium_at(const S& scene, const Vec3& x, int inside, F&& f) {
     if (d > 0) f(obj.medium, d);
     return;
   }
+  // Object i, whose bounds hold x.
   auto visit = [&](int i) {
     const auto& obj = scene.objects[i];
-    if (!obj.bounds.contains(x)) return;
     const double F_x = evaluate(obj.tape, x);
     if (F_x <= 0) return;
     const double d = medium_density(scene.media[obj.medium], x, F_x);
@@ -75,7 +75,8 @@ void for_each_medium_at(const S& scene, const Vec3& x, int inside, F&& f) {
       return;
     }
   }
-  for (int i : scene.field_objects) visit(i);
+  for (int i : scene.field_objects)
+    if (scene.objects[i].bounds.contains(x)) visit(i);
 }
 
 namespace medium_field_detail {
