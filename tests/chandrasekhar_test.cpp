@@ -6,7 +6,7 @@
 #include <numbers>
 
 namespace nimbus::test {
-namespace {
+namespace chandrasekhar_test {
 
 // The quadrature is accurate to ~1e-13 (two DE levels agree to 1e-12 and it converges
 // double-exponentially), so identities are checked to 1e-10; tables have 5 decimals.
@@ -69,5 +69,5 @@ TEST(Chandrasekhar, HalfSpaceReflectsItsPlaneAlbedo) {
   }
 }
 
-}  // namespace
+}  // namespace chandrasekhar_test
 }  // namespace nimbus::test

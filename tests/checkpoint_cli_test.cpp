@@ -17,10 +17,10 @@
 #include "support/process.h"
 
 namespace nimbus {
-namespace {
+namespace checkpoint_cli_test {
 
 namespace fs = std::filesystem;
-using namespace nimbus::testing;
+using namespace nimbus::test;
 
 // A small scene with a medium: 24 x 16 pixels.
 constexpr const char* kScene = R"({
@@ -319,5 +319,5 @@ TEST_F(Checkpoints, AStopBeforeTheFirstSampleWritesNothing) {
   EXPECT_TRUE(file_bytes(dir_ / "ck.nck") == checkpoint) << "ck.nck was replaced";
 }
 
-}  // namespace
+}  // namespace checkpoint_cli_test
 }  // namespace nimbus

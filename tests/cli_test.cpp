@@ -17,12 +17,12 @@
 #include "nimbus/render/wavelength_counts.h"
 #include "support/process.h"
 
-namespace {
+namespace cli_test {
 
 namespace fs = std::filesystem;
-using nimbus::testing::fresh_test_dir;
-using nimbus::testing::Ran;
-using nimbus::testing::run_nimbus_in;
+using nimbus::test::fresh_test_dir;
+using nimbus::test::Ran;
+using nimbus::test::run_nimbus_in;
 
 class Cli : public ::testing::Test {
  protected:
@@ -419,10 +419,9 @@ TEST_F(Cli, OutOfMemoryIsOneLine) {
 #endif
 #endif
   write("scene.json", good_scene().dump());
-  const Ran r =
-      nimbus::testing::run_in(dir_, std::string("ulimit -v 1500000 && '") + NIMBUS_BINARY +
-                                        "' render scene.json --set film.width=16384 --set "
-                                        "film.height=16384 --max-memory 100G -q -o a.png");
+  const Ran r = nimbus::test::run_in(dir_, std::string("ulimit -v 1500000 && '") + NIMBUS_BINARY +
+                                               "' render scene.json --set film.width=16384 --set "
+                                               "film.height=16384 --max-memory 100G -q -o a.png");
   EXPECT_EQ(r.code, 1);
   EXPECT_EQ(r.err,
             "nimbus: out of memory: the machine could not give what the run needed (does "
@@ -442,4 +441,4 @@ TEST_F(Cli, OutputIsTheSameForOneAndTwoThreads) {
   EXPECT_EQ(run("render scene.json -q").err, "");
 }
 
-}  // namespace
+}  // namespace cli_test

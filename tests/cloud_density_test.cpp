@@ -7,7 +7,7 @@
 #include "nimbus/math/rng.h"
 
 namespace nimbus {
-namespace {
+namespace cloud_density_test {
 
 Vec3 random_point(Rng& rng, double r) {
   return {r * (2 * rng.uniform() - 1), r * (2 * rng.uniform() - 1), r * (2 * rng.uniform() - 1)};
@@ -115,5 +115,5 @@ TEST(CloudDensity, ErodedEdgeHasHolesAndDenseCore) {
   EXPECT_EQ(thin_core, 0);
 }
 
-}  // namespace
+}  // namespace cloud_density_test
 }  // namespace nimbus

@@ -16,7 +16,7 @@
 #include "support/vdb_grids.h"
 
 namespace nimbus {
-namespace {
+namespace density_test {
 
 TEST(Density, EveryTypesRangeHoldsItsValues) {
   // The holding object's function: a unit sphere's 1 − |x|², evaluated as the octree does.
@@ -72,5 +72,5 @@ TEST(Density, TheTableNamesEachTypeOnce) {
   EXPECT_EQ(names.front(), "constant") << "the default comes first";
 }
 
-}  // namespace
+}  // namespace density_test
 }  // namespace nimbus

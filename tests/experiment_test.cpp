@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-namespace {
+namespace experiment_test {
 
 namespace fs = std::filesystem;
 
@@ -231,4 +231,4 @@ TEST_F(Experiment, OctreeDepthQuick) {
   EXPECT_LT(num(csv.rows[2], "lookups_per_sample"), 0.5 * at_depth0);
 }
 
-}  // namespace
+}  // namespace experiment_test

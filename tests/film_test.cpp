@@ -20,7 +20,7 @@
 #include "support/scene_builders.h"
 
 namespace nimbus {
-namespace {
+namespace film_test {
 
 // A cloud in a sphere under a sun and a sky: media, shadow rays and surfaces-free paths.
 Scene small_scene(int spp) {
@@ -305,5 +305,5 @@ TEST(Film, RoundTripsThroughAFile) {
   std::filesystem::remove_all(dir);
 }
 
-}  // namespace
+}  // namespace film_test
 }  // namespace nimbus

@@ -7,7 +7,7 @@
 #include "nimbus/frep/tape.h"
 
 namespace nimbus {
-namespace {
+namespace frep_bounds_test {
 
 using test::leaf;
 
@@ -97,5 +97,5 @@ TEST(Bounds, GalleryBoxesAreConservativeAndTight) {
   }
 }
 
-}  // namespace
+}  // namespace frep_bounds_test
 }  // namespace nimbus

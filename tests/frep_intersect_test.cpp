@@ -11,7 +11,7 @@
 #include "nimbus/scene/load.h"
 
 namespace nimbus {
-namespace {
+namespace frep_intersect_test {
 
 using test::GalleryShape;
 using test::random_in_cube;
@@ -322,5 +322,5 @@ TEST(FirstHit, EmptyShapeIsNeverHit) {
   EXPECT_TRUE(first_hit(tape, Ray{{-10, 0, 0}, {1, 0, 0}}, 0, 1e30));
 }
 
-}  // namespace
+}  // namespace frep_intersect_test
 }  // namespace nimbus

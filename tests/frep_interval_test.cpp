@@ -10,7 +10,7 @@
 #include "nimbus/frep/tape_eval.h"
 
 namespace nimbus {
-namespace {
+namespace frep_interval_test {
 
 using test::leaf;
 using test::random_in_cube;
@@ -109,5 +109,5 @@ TEST(TapeInterval, InfiniteBoxIsEverything) {
   EXPECT_TRUE(std::isinf(range.lo) && std::isinf(range.hi));
 }
 
-}  // namespace
+}  // namespace frep_interval_test
 }  // namespace nimbus

@@ -7,7 +7,7 @@
 #include "nimbus/frep/tape.h"
 
 namespace nimbus {
-namespace {
+namespace frep_tape_test {
 
 using test::gallery;
 using test::leaf;
@@ -177,5 +177,5 @@ TEST(Tape, IsCopyableAndEvaluatesTheSameAfterCopy) {
   EXPECT_EQ(evaluate(copy, x), evaluate(original, x));
 }
 
-}  // namespace
+}  // namespace frep_tape_test
 }  // namespace nimbus

@@ -8,7 +8,7 @@
 #include "nimbus/math/rng.h"
 
 namespace nimbus {
-namespace {
+namespace interval_test {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -93,7 +93,7 @@ TEST(Interval, BoundsAreRoundedOutward) {
   EXPECT_LE(static_cast<long double>(c.lo), exact);
   EXPECT_GE(static_cast<long double>(c.hi), exact);
   // max(x, 0)³ of a non-positive interval is exactly 0.
-  const Interval z = positive_cube({-2.0, -1.0});
+  const Interval z = positive_cube(Interval{-2.0, -1.0});
   EXPECT_EQ(z.lo, 0.0);
   EXPECT_EQ(z.hi, 0.0);
 }
@@ -113,5 +113,5 @@ TEST(Interval, ExcludesZero) {
   EXPECT_FALSE((Interval{-1.0, 0.0}).excludes_zero());
 }
 
-}  // namespace
+}  // namespace interval_test
 }  // namespace nimbus

@@ -21,7 +21,7 @@
 #include "nimbus/io/png.h"
 
 namespace nimbus {
-namespace {
+namespace io_test {
 
 namespace fs = std::filesystem;
 
@@ -258,5 +258,5 @@ TEST_F(IoTest, TemporariesOfDeadRunsAreRemovedByTheNextWrite) {
   EXPECT_EQ(listing(), expected);
 }
 
-}  // namespace
+}  // namespace io_test
 }  // namespace nimbus

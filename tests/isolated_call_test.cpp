@@ -26,7 +26,7 @@
 #include "support/sanitizer.h"
 
 namespace nimbus {
-namespace {
+namespace isolated_call_test {
 
 using Status = IsolatedResult::Status;
 
@@ -187,5 +187,5 @@ TEST(IsolatedCall, InsideAParallelLoopNothingIsForked) {
   EXPECT_EQ(ran.load(), 0);
 }
 
-}  // namespace
+}  // namespace isolated_call_test
 }  // namespace nimbus

@@ -14,7 +14,7 @@
 #include "nimbus/scene/load.h"
 
 namespace nimbus {
-namespace {
+namespace job_test {
 
 Film numbered_film(int w, int h) {
   Film f(w, h);
@@ -255,5 +255,5 @@ TEST(Fingerprint, HoldsEveryFileTheLoaderRead) {
   fs::remove_all(dir);
 }
 
-}  // namespace
+}  // namespace job_test
 }  // namespace nimbus

@@ -14,7 +14,7 @@
 #include "support/stats.h"
 
 namespace nimbus {
-namespace {
+namespace light_choice_test {
 
 struct Lights {
   Scene scene;
@@ -177,5 +177,5 @@ TEST(LightChoice, DarkLights) {
   EXPECT_EQ(choose_light(l.scene, l.ps, Vec3{0, 0, 0}, 0.6).first, 2);
 }
 
-}  // namespace
+}  // namespace light_choice_test
 }  // namespace nimbus

@@ -20,7 +20,7 @@
 #include "nimbus/scene/load.h"
 
 namespace nimbus {
-namespace {
+namespace light_tree_render_test {
 
 TEST(LightTree, ThousandsOfLightsRenderTheClosedForm) {
   constexpr double kAlbedo = 0.5, kHalf = 1.0;  // the view: x, z in [-1, 1]
@@ -91,5 +91,5 @@ TEST(LightTree, ThousandsOfLightsRenderTheClosedForm) {
   }
 }
 
-}  // namespace
+}  // namespace light_tree_render_test
 }  // namespace nimbus

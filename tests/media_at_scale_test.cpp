@@ -22,7 +22,7 @@
 #include "support/scene_builders.h"
 
 namespace nimbus {
-namespace {
+namespace media_at_scale_test {
 
 // The scene's media as the loop over every field object sees them: no field octree.
 struct EveryObject {
@@ -228,5 +228,5 @@ TEST(ManyMedia, MoreAnisotropiesThanLobesGetOneLineNamingTheObject) {
   EXPECT_THROW(finish_scene(scene), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace media_at_scale_test
 }  // namespace nimbus

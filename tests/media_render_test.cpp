@@ -27,7 +27,7 @@
 #include "support/weight_growth.h"
 
 namespace nimbus {
-namespace {
+namespace media_render_test {
 
 // One combination of the integrator's tracking settings.
 struct ModeCase {
@@ -568,5 +568,5 @@ TEST(MediaRenderCost, AnOpticallyDenseSphereCostsItsRealCollisionsOnly) {
 
 INSTANTIATE_TEST_SUITE_P(Modes, MediaRender, testing::ValuesIn(mode_cases()), mode_name);
 
-}  // namespace
+}  // namespace media_render_test
 }  // namespace nimbus

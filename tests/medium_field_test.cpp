@@ -16,7 +16,7 @@
 #include "nimbus/frep/tape.h"
 
 namespace nimbus {
-namespace {
+namespace medium_field_test {
 
 struct Named {
   std::string name;
@@ -139,5 +139,5 @@ TEST(ObjectSpans, AddSpanKeepsTheSortedUnionAndRefusesOverflowUnchanged) {
   EXPECT_GT(merges, 10000);
 }
 
-}  // namespace
+}  // namespace medium_field_test
 }  // namespace nimbus

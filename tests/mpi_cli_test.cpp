@@ -13,10 +13,10 @@
 #include "support/process.h"
 
 namespace nimbus {
-namespace {
+namespace mpi_cli_test {
 
 namespace fs = std::filesystem;
-using namespace nimbus::testing;
+using namespace nimbus::test;
 
 // A dense cloud in one corner of the image and thin haze elsewhere: 40 x 24 pixels.
 constexpr const char* kScene = R"({
@@ -182,5 +182,5 @@ TEST_F(Mpi, ARankKilledLeavesNoOutputAndTheCheckpointResumes) {
 #endif
 }
 
-}  // namespace
+}  // namespace mpi_cli_test
 }  // namespace nimbus

@@ -9,7 +9,7 @@
 #include "nimbus/math/rng.h"
 
 namespace nimbus {
-namespace {
+namespace noise_test {
 
 Vec3 random_point(Rng& rng, double r) {
   return {r * (2 * rng.uniform() - 1), r * (2 * rng.uniform() - 1), r * (2 * rng.uniform() - 1)};
@@ -100,5 +100,5 @@ TEST(Noise, FbmBoundIsSumOfOctaveBounds) {
   }
 }
 
-}  // namespace
+}  // namespace noise_test
 }  // namespace nimbus

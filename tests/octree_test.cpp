@@ -21,7 +21,7 @@
 #include "nimbus/render/scene.h"
 
 namespace nimbus {
-namespace {
+namespace octree_test {
 
 void add_field_object(Scene& scene, const ShapePtr& shape, const Medium& medium) {
   SceneObject obj;
@@ -656,5 +656,5 @@ TEST(Octree, MajorantScaleMultipliesTheWalkedMajorants) {
   }
 }
 
-}  // namespace
+}  // namespace octree_test
 }  // namespace nimbus

@@ -12,7 +12,7 @@
 #include "support/stats.h"
 
 namespace nimbus {
-namespace {
+namespace phase_test {
 
 constexpr double kPi = std::numbers::pi;
 
@@ -138,5 +138,5 @@ TEST(Phase, MeanCosineIsG) {
   }
 }
 
-}  // namespace
+}  // namespace phase_test
 }  // namespace nimbus

@@ -15,7 +15,7 @@
 #include "nimbus/spectral/color.h"
 
 namespace nimbus {
-namespace {
+namespace planck_test {
 
 TEST(Planck, RadianceIntegratesToStefanBoltzmann) {
   constexpr double kSigma = 5.670374419e-8;  // W·m⁻²·K⁻⁴
@@ -68,5 +68,5 @@ TEST(Planck, RgbTableAgreesWithTheIntegration) {
   EXPECT_EQ(planck_rgb(-5).max_abs(), 0.0);
 }
 
-}  // namespace
+}  // namespace planck_test
 }  // namespace nimbus

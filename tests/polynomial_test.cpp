@@ -9,7 +9,7 @@
 #include "nimbus/math/rng.h"
 
 namespace nimbus {
-namespace {
+namespace polynomial_test {
 
 // Coefficients (increasing powers) of scale · Π (x − r_i).
 std::vector<double> from_roots(const std::vector<double>& roots, double scale = 1.0) {
@@ -140,5 +140,5 @@ TEST(Polynomial, RandomRootsAreAllFound) {
   }
 }
 
-}  // namespace
+}  // namespace polynomial_test
 }  // namespace nimbus

@@ -7,7 +7,7 @@
 #include "nimbus/math/rng.h"
 
 namespace nimbus {
-namespace {
+namespace quadric_test {
 
 Vec3 random_point(Rng& rng, double r) {
   return {r * (2 * rng.uniform() - 1), r * (2 * rng.uniform() - 1), r * (2 * rng.uniform() - 1)};
@@ -103,11 +103,11 @@ TEST(Primitives, SurfacesPassThroughParameterPoints) {
   EXPECT_GT(sl.eval(c), 0);
 }
 
-}  // namespace
+}  // namespace quadric_test
 }  // namespace nimbus
 
 namespace nimbus {
-namespace {
+namespace quadric_test {
 
 TEST(Box, ClipRayMissesAnEmptyBox) {
   double t0 = 0, t1 = 10;
@@ -118,5 +118,5 @@ TEST(Box, ClipRayMissesAnEmptyBox) {
   EXPECT_DOUBLE_EQ(t1, 6);
 }
 
-}  // namespace
+}  // namespace quadric_test
 }  // namespace nimbus

@@ -18,7 +18,7 @@
 #include "support/process.h"
 
 namespace nimbus {
-namespace {
+namespace render_job_test {
 
 namespace fs = std::filesystem;
 
@@ -34,7 +34,7 @@ constexpr const char* kScene = R"({
 class Job : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = testing::fresh_test_dir("nimbus_job");
+    dir_ = test::fresh_test_dir("nimbus_job");
     scene_ = (dir_ / "scene.json").string();
     std::ofstream(scene_) << kScene;
   }
@@ -158,5 +158,5 @@ TEST_F(Job, ASceneBuiltInCodeResumesUnderItsIdentity) {
   EXPECT_THROW(refused.set_scene(scene, {}), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace render_job_test
 }  // namespace nimbus

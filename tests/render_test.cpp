@@ -14,7 +14,7 @@
 #include "support/stats.h"
 
 namespace nimbus {
-namespace {
+namespace render_test {
 
 // The tests here take their tolerances from per-pixel sample variances, which estimate the
 // variance of a pixel's mean for independent samples only: they ask for the independent sampler
@@ -104,11 +104,11 @@ TEST(Render, ImageIsBitIdenticalForAnyThreadCount) {
   }
 }
 
-}  // namespace
+}  // namespace render_test
 }  // namespace nimbus
 
 namespace nimbus {
-namespace {
+namespace render_test {
 
 // A diffuse floor under a sphere light (radius r, radiance L_s): a uniform sphere above the
 // horizon irradiates like a point of intensity π r² L_s at its centre, so the floor's radiance
@@ -211,5 +211,5 @@ TEST(Render, FourLightsOnDiffuseFloorMatchClosedForm) {
     }
 }
 
-}  // namespace
+}  // namespace render_test
 }  // namespace nimbus

@@ -22,7 +22,7 @@
 #include "support/stats.h"
 
 namespace nimbus {
-namespace {
+namespace sampler_render_test {
 
 using Sampler = RenderSettings::Sampler;
 
@@ -177,5 +177,5 @@ TEST(SamplerRender, ZSobolImageIsTheSameForAnyThreadCount) {
   }
 }
 
-}  // namespace
+}  // namespace sampler_render_test
 }  // namespace nimbus

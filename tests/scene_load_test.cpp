@@ -20,7 +20,7 @@
 #include "nimbus/spectral/color.h"
 
 namespace nimbus {
-namespace {
+namespace scene_load_test {
 
 // The density a medium of a description makes when the scene is compiled.
 DensityPtr made_density(const MediumDesc& m) {
@@ -1017,5 +1017,5 @@ TEST_F(SceneFileTest, OnlyRegularUtf8FilesOfBoundedSizeAreRead) {
                                          big, kMaxSceneFileBytes + 1, kMaxSceneFileBytes));
 }
 
-}  // namespace
+}  // namespace scene_load_test
 }  // namespace nimbus

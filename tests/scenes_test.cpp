@@ -13,7 +13,7 @@
 #include "nimbus/scene/load.h"
 
 namespace nimbus {
-namespace {
+namespace scenes_test {
 
 std::vector<std::string> shipped_scenes() {
   std::vector<std::string> out;
@@ -41,5 +41,5 @@ TEST(Scenes, EveryShippedSceneLoadsAndRenders) {
   }
 }
 
-}  // namespace
+}  // namespace scenes_test
 }  // namespace nimbus

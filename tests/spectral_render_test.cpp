@@ -29,7 +29,7 @@
 #include "support/weight_growth.h"
 
 namespace nimbus {
-namespace {
+namespace spectral_render_test {
 
 using Mode = TrackingSettings::Mode;
 using Absorption = TrackingSettings::Absorption;
@@ -351,5 +351,5 @@ TEST(SpectralRenderGrey, WavelengthCountOutOfRangeIsRefused) {
   EXPECT_THROW(render(scene), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace spectral_render_test
 }  // namespace nimbus

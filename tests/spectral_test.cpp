@@ -19,7 +19,7 @@
 #include "support/stats.h"
 
 namespace nimbus {
-namespace {
+namespace spectral_test {
 
 using test::simpson;
 
@@ -408,5 +408,5 @@ TEST(SpectralCurve, BlackbodyPeaksAtWiensWavelength) {
   }
 }
 
-}  // namespace
+}  // namespace spectral_test
 }  // namespace nimbus

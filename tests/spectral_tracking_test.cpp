@@ -26,7 +26,7 @@
 #include "support/stats.h"
 
 namespace nimbus {
-namespace {
+namespace spectral_tracking_test {
 
 constexpr double kT0 = 0.2, kT1 = 1.4;
 const Rgb kAlbedo{{0.95, 0.5, 0.8}};
@@ -346,5 +346,5 @@ TEST(HeroTracking, UnbiasedWhereMajorantsFail) {
     }
 }
 
-}  // namespace
+}  // namespace spectral_tracking_test
 }  // namespace nimbus

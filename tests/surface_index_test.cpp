@@ -17,7 +17,7 @@
 #include "support/scene_builders.h"
 
 namespace nimbus {
-namespace {
+namespace surface_index_test {
 
 using test::random_in_cube;
 using test::random_unit;
@@ -220,5 +220,5 @@ TEST(SurfaceIndex, AnEmptySceneHitsNothing) {
   EXPECT_FALSE(occluded(scene, Ray{{0, 0, 0}, {0, 0, 1}}, Box::kInf));
 }
 
-}  // namespace
+}  // namespace surface_index_test
 }  // namespace nimbus

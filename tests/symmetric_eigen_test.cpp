@@ -7,7 +7,7 @@
 #include "nimbus/math/rng.h"
 
 namespace nimbus {
-namespace {
+namespace symmetric_eigen_test {
 
 using Matrix = std::array<std::array<double, 3>, 3>;
 
@@ -52,5 +52,5 @@ TEST(SymmetricEigen, HandlesRepeatedAndZeroEigenvalues) {
   EXPECT_EQ(zeros, 2);
 }
 
-}  // namespace
+}  // namespace symmetric_eigen_test
 }  // namespace nimbus

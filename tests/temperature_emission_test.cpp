@@ -30,7 +30,7 @@
 #include "support/vdb_grids.h"
 
 namespace nimbus {
-namespace {
+namespace temperature_emission_test {
 
 using test::TempDir;
 
@@ -313,5 +313,5 @@ TEST(TemperatureGridErrors, TheCommandLineExitsTwoWithoutOutput) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("out.png")));
 }
 
-}  // namespace
+}  // namespace temperature_emission_test
 }  // namespace nimbus

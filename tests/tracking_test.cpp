@@ -17,7 +17,7 @@
 #include "support/stats.h"
 
 namespace nimbus {
-namespace {
+namespace tracking_test {
 
 constexpr double kT0 = 0.3, kT1 = 1.8;
 const Rgb kAlbedo{{0.9, 0.5, 0.2}};
@@ -405,11 +405,11 @@ TEST(DeltaTracking, NonBoundingMajorantClampsAndSaysSo) {
   EXPECT_GT(std::abs(escaped.mean - std::exp(-mu_t * L)), 4 * escaped.std_error());
 }
 
-}  // namespace
+}  // namespace tracking_test
 }  // namespace nimbus
 
 namespace nimbus {
-namespace {
+namespace tracking_test {
 
 TEST(TransmittanceRoulette, KeepsTheExpectation) {
   Rng rng(17);
@@ -440,5 +440,5 @@ TEST(TransmittanceRoulette, DenseMediumIsUnbiasedAndCheap) {
   EXPECT_LT(double(counters.tentative_collisions) / n, 0.5 * mu_bar * length);
 }
 
-}  // namespace
+}  // namespace tracking_test
 }  // namespace nimbus

@@ -15,12 +15,12 @@
 #include "support/process.h"
 #include "support/vdb_grids.h"
 
-namespace {
+namespace vdb_cli_test {
 
 namespace fs = std::filesystem;
-using nimbus::testing::fresh_test_dir;
-using nimbus::testing::Ran;
-using nimbus::testing::run_in;
+using nimbus::test::fresh_test_dir;
+using nimbus::test::Ran;
+using nimbus::test::run_in;
 
 class VdbCli : public ::testing::Test {
  protected:
@@ -164,4 +164,4 @@ TEST_F(VdbCli, ExportVdbRefusesBadInputWithExitTwoAndNoOutput) {
   EXPECT_EQ(run("export-vdb scene.json -o out.vdb").code, 2) << "--voxel-size is required";
 }
 
-}  // namespace
+}  // namespace vdb_cli_test

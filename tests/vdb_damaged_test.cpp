@@ -12,7 +12,7 @@
 #include "support/sanitizer.h"
 
 namespace nimbus {
-namespace {
+namespace vdb_damaged_test {
 
 const std::string kDamaged = std::string(NIMBUS_SOURCE_DIR) + "/tests/data/vdb_damaged/";
 
@@ -53,5 +53,5 @@ TEST(VdbDamaged, AHugeAllocationStopsAtTheChildsLimitNotInThisProcess) {
   EXPECT_LT(max_resident_kib(), 512 * 1024) << "read in this process, not in a child";
 }
 
-}  // namespace
+}  // namespace vdb_damaged_test
 }  // namespace nimbus

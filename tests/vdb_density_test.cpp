@@ -26,7 +26,7 @@
 #include "support/vdb_grids.h"
 
 namespace nimbus {
-namespace {
+namespace vdb_density_test {
 
 using test::ball_value;
 using test::linear_value;
@@ -426,5 +426,5 @@ TEST(VdbDensity, BadInputIsOneLineNamingTheJsonPathAndTheFile) {
             "(no error)");
 }
 
-}  // namespace
+}  // namespace vdb_density_test
 }  // namespace nimbus

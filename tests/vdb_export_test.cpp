@@ -26,7 +26,7 @@
 #include "support/vdb_grids.h"
 
 namespace nimbus {
-namespace {
+namespace vdb_export_test {
 
 using test::TempDir;
 
@@ -277,5 +277,5 @@ TEST(VdbExport, TheShippedExampleIsTheExportOfItsSourceScene) {
   for (int c = 0; c < 3; ++c) EXPECT_TRUE(std::isfinite(m.mean[c]) && m.mean[c] > 0);
 }
 
-}  // namespace
+}  // namespace vdb_export_test
 }  // namespace nimbus

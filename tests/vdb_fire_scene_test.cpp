@@ -20,7 +20,7 @@
 #include "support/vdb_grids.h"
 
 namespace nimbus {
-namespace {
+namespace vdb_fire_scene_test {
 
 const std::string kScenes = std::string(NIMBUS_SOURCE_DIR) + "/scenes/";
 
@@ -105,5 +105,5 @@ TEST(VdbFireScene, TheCommittedGridsAreTheGeneratorsAndTheSceneRendersFire) {
   EXPECT_GT(brightest[1], brightest[2]);
 }
 
-}  // namespace
+}  // namespace vdb_fire_scene_test
 }  // namespace nimbus

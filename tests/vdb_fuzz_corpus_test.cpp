@@ -17,7 +17,7 @@
 #include "support/vdb_grids.h"
 
 namespace nimbus {
-namespace {
+namespace vdb_fuzz_corpus_test {
 
 namespace fs = std::filesystem;
 
@@ -80,5 +80,5 @@ TEST(VdbFuzzCorpus, EveryFileReadsToAGridOrAVdbError) {
   EXPECT_EQ(errors, 6);
 }
 
-}  // namespace
+}  // namespace vdb_fuzz_corpus_test
 }  // namespace nimbus

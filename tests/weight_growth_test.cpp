@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 namespace nimbus {
-namespace {
+namespace weight_growth_test {
 
 using test::medium_growth;
 
@@ -40,5 +40,5 @@ TEST(WeightGrowth, DeltaTrackingWithABoundingMajorantNeverGrows) {
               1e-12);
 }
 
-}  // namespace
+}  // namespace weight_growth_test
 }  // namespace nimbus

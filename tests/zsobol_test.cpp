@@ -14,7 +14,7 @@
 #include "support/stats.h"
 
 namespace nimbus {
-namespace {
+namespace zsobol_test {
 
 // Whether n = 2^m points put exactly one point in every elementary interval of area 1/n
 // (2^a × 2^(m−a) cells, every a): a (0,m,2)-net in base 2.
@@ -193,5 +193,5 @@ TEST(ZSobol, EachNumberIsUniformOverSeeds) {
   }
 }
 
-}  // namespace
+}  // namespace zsobol_test
 }  // namespace nimbus

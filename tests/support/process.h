@@ -18,7 +18,7 @@
 #include <utility>
 #include <vector>
 
-namespace nimbus::testing {
+namespace nimbus::test {
 
 struct Ran {
   int code = -1;
@@ -107,4 +107,4 @@ inline bool same_bytes(const std::filesystem::path& a, const std::filesystem::pa
   return file_bytes(a) == file_bytes(b);
 }
 
-}  // namespace nimbus::testing
+}  // namespace nimbus::test

@@ -10,6 +10,7 @@
 #include <limits>
 #include <optional>
 
+#include "nimbus/math/constants.h"
 #include "nimbus/math/ray.h"
 #include "nimbus/math/rng.h"
 #include "nimbus/media/medium_field.h"
@@ -26,7 +27,6 @@
 namespace nimbus {
 namespace integrator_detail {
 
-inline constexpr double kInf = std::numeric_limits<double>::infinity();
 inline constexpr double kShadowShrink = 1 - 1e-7;
 
 // One light sample for next-event estimation at p, from the 2D number u, with the scattering

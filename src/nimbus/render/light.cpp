@@ -9,7 +9,6 @@
 
 namespace nimbus {
 namespace {
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 double sphere_cos_max(const Light& l, double dist2) {
   const double sin2 = l.radius * l.radius / dist2;

@@ -19,16 +19,16 @@ bool positioned(const Light& light) {
   return light.type == Light::Type::Point || light.type == Light::Type::Sphere;
 }
 
-struct Item {
+struct LightItem {
   Box bounds;
   Vec3 centre;
   double power;
   int light;
 };
 
-class Builder {
+class LightTreeBuilder {
  public:
-  Builder(std::vector<Item>& items, LightTree& tree) : items_(items), tree_(tree) {}
+  LightTreeBuilder(std::vector<LightItem>& items, LightTree& tree) : items_(items), tree_(tree) {}
 
   // The subtree of items [first, last) at node `at`, reached from the root by `trail`.
   void build(std::uint32_t at, size_t first, size_t last, std::uint64_t trail, int depth) {
@@ -52,7 +52,7 @@ class Builder {
     const int axis = e.x >= e.y && e.x >= e.z ? 0 : e.y >= e.z ? 1 : 2;
     const size_t mid = first + (last - first) / 2;
     std::nth_element(items_.begin() + long(first), items_.begin() + long(mid),
-                     items_.begin() + long(last), [axis](const Item& a, const Item& b) {
+                     items_.begin() + long(last), [axis](const LightItem& a, const LightItem& b) {
                        return a.centre[axis] < b.centre[axis] ||
                               (a.centre[axis] == b.centre[axis] && a.light < b.light);
                      });
@@ -66,7 +66,7 @@ class Builder {
   }
 
  private:
-  std::vector<Item>& items_;
+  std::vector<LightItem>& items_;
   LightTree& tree_;
 };
 
@@ -74,7 +74,7 @@ class Builder {
 
 LightTree build_light_tree(const std::vector<Light>& lights) {
   LightTree tree;
-  std::vector<Item> items;
+  std::vector<LightItem> items;
   for (size_t i = 0; i < lights.size(); ++i) {
     const Light& l = lights[i];
     if (!positioned(l)) continue;
@@ -89,7 +89,7 @@ LightTree build_light_tree(const std::vector<Light>& lights) {
   tree.depth.assign(lights.size(), -1);
   tree.nodes.reserve(2 * items.size());
   tree.nodes.emplace_back();
-  Builder(items, tree).build(0, 0, items.size(), 0, 0);
+  LightTreeBuilder(items, tree).build(0, 0, items.size(), 0, 0);
   return tree;
 }
 

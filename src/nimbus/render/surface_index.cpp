@@ -17,7 +17,7 @@ constexpr size_t kListSize = 8;
 constexpr int kMedianDepth = 40;  // below this depth splits are by count, bounding the depth
 constexpr double kCostVisit = 1;  // a node's box test, relative to one surface's test (SAH)
 
-struct Item {
+struct SurfaceItem {
   Box bounds;
   Vec3 centroid;
   std::uint32_t id;
@@ -29,9 +29,10 @@ double half_area(const Box& b) {
   return e.x * e.y + e.y * e.z + e.z * e.x;
 }
 
-class Builder {
+class SurfaceTreeBuilder {
  public:
-  Builder(std::vector<Item>& items, SurfaceIndex& index) : items_(items), index_(index) {}
+  SurfaceTreeBuilder(std::vector<SurfaceItem>& items, SurfaceIndex& index)
+      : items_(items), index_(index) {}
 
   // Builds the subtree of items [first, last) at node `at` (already pushed).
   void build(std::uint32_t at, size_t first, size_t last, int depth) {
@@ -51,7 +52,8 @@ class Builder {
       axis = e.x >= e.y && e.x >= e.z ? 0 : e.y >= e.z ? 1 : 2;
       mid = first + n / 2;
       std::nth_element(items_.begin() + long(first), items_.begin() + long(mid),
-                       items_.begin() + long(last), [axis](const Item& a, const Item& b) {
+                       items_.begin() + long(last),
+                       [axis](const SurfaceItem& a, const SurfaceItem& b) {
                          return a.centroid[axis] < b.centroid[axis] ||
                                 (a.centroid[axis] == b.centroid[axis] && a.id < b.id);
                        });
@@ -120,8 +122,9 @@ class Builder {
     if (best_axis < 0) return false;
     const double lo = centroids.lo[best_axis], width = centroids.hi[best_axis] - lo;
     const auto split = std::partition(
-        items_.begin() + long(first), items_.begin() + long(last),
-        [&](const Item& item) { return bin_of(item.centroid[best_axis], lo, width) <= best_bin; });
+        items_.begin() + long(first), items_.begin() + long(last), [&](const SurfaceItem& item) {
+          return bin_of(item.centroid[best_axis], lo, width) <= best_bin;
+        });
     axis = best_axis;
     mid = static_cast<size_t>(split - items_.begin());
     return mid > first && mid < last;
@@ -133,7 +136,7 @@ class Builder {
   }
 
   static constexpr double kInfinity = Box::kInf;
-  std::vector<Item>& items_;
+  std::vector<SurfaceItem>& items_;
   SurfaceIndex& index_;
 };
 
@@ -142,7 +145,7 @@ class Builder {
 SurfaceIndex build_surface_index(const std::vector<SceneObject>& objects,
                                  const std::vector<Light>& lights) {
   SurfaceIndex index;
-  std::vector<Item> items;
+  std::vector<SurfaceItem> items;
   for (size_t i = 0; i < objects.size(); ++i)
     if (objects[i].surface.type != Surface::Type::None) {
       index.objects.push_back(int(i));
@@ -167,13 +170,13 @@ SurfaceIndex build_surface_index(const std::vector<SceneObject>& objects,
   index.nodes.emplace_back();
   if (items.size() <= kListSize) {
     index.nodes[0].count = static_cast<std::uint16_t>(items.size());
-    for (const Item& item : items) {
+    for (const SurfaceItem& item : items) {
       index.nodes[0].bounds = unite(index.nodes[0].bounds, item.bounds);
       index.entries.push_back(item.id);
     }
     return index;
   }
-  Builder(items, index).build(0, 0, items.size(), 0);
+  SurfaceTreeBuilder(items, index).build(0, 0, items.size(), 0);
   return index;
 }
 

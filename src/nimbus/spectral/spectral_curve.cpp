@@ -47,13 +47,13 @@ double piecewise_linear(const std::vector<std::pair<double, double>>& points, do
   return (1 - t) * lo->second + t * hi->second;
 }
 
-using Bounds = std::pair<double, double>;
+using ValueRange = std::pair<double, double>;
 
-Bounds ordered(double a, double b) {
-  return a < b ? Bounds{a, b} : Bounds{b, a};
+ValueRange ordered(double a, double b) {
+  return a < b ? ValueRange{a, b} : ValueRange{b, a};
 }
 
-Bounds times(const Bounds& a, const Bounds& b) {
+ValueRange times(const ValueRange& a, const ValueRange& b) {
   const double p[4] = {a.first * b.first, a.first * b.second, a.second * b.first,
                        a.second * b.second};
   return {*std::min_element(p, p + 4), *std::max_element(p, p + 4)};
@@ -61,8 +61,8 @@ Bounds times(const Bounds& a, const Bounds& b) {
 
 // The exact bounds of d65_illuminant over [lo, hi]: it is linear between its 5 nm knots (and 0
 // outside [kLambdaMin, kLambdaMax]), so the extremes are at lo, hi or a knot between them.
-Bounds d65_bounds(double lo, double hi) {
-  Bounds b = ordered(d65_illuminant(lo), d65_illuminant(hi));
+ValueRange d65_bounds(double lo, double hi) {
+  ValueRange b = ordered(d65_illuminant(lo), d65_illuminant(hi));
   for (int i = 0; i < kBands; ++i) {
     const double lambda = kLambdaMin + i * kStep;
     if (lambda > lo && lambda < hi) {
@@ -88,7 +88,7 @@ double shape(const SpectralCurve& s, double lambda) {
   return 0;
 }
 
-Bounds shape_bounds(const SpectralCurve& s, double lo, double hi) {
+ValueRange shape_bounds(const SpectralCurve& s, double lo, double hi) {
   switch (s.type) {
     case SpectralCurve::Type::Constant:
       return {1, 1};
@@ -96,7 +96,7 @@ Bounds shape_bounds(const SpectralCurve& s, double lo, double hi) {
       // S is increasing, so the bounds are S at the quadratic's extremes: at the ends or at its
       // vertex −c1 / (2 c0).
       auto q = [&](double l) { return (s.c0 * l + s.c1) * l + s.c2; };
-      Bounds b = ordered(q(lo), q(hi));
+      ValueRange b = ordered(q(lo), q(hi));
       if (s.c0 != 0) {
         const double vertex = -s.c1 / (2 * s.c0);
         if (vertex > lo && vertex < hi) {
@@ -107,7 +107,7 @@ Bounds shape_bounds(const SpectralCurve& s, double lo, double hi) {
     }
     case SpectralCurve::Type::PiecewiseLinear: {
       // Linear between knots and constant beyond them: extremes at lo, hi or a knot between.
-      Bounds b = ordered(piecewise_linear(s.points, lo), piecewise_linear(s.points, hi));
+      ValueRange b = ordered(piecewise_linear(s.points, lo), piecewise_linear(s.points, hi));
       for (const auto& [lambda, v] : s.points) {
         if (lambda > lo && lambda < hi) b = {std::min(b.first, v), std::max(b.second, v)};
       }
@@ -216,7 +216,7 @@ double SpectralCurve::operator()(double lambda) const {
 std::pair<double, double> SpectralCurve::range(double lo, double hi) const {
   // With D65 the bound is the product of the two ranges: safe, but not tight where the curve's
   // and D65's extremes fall at different wavelengths.
-  const Bounds b = times(shape_bounds(*this, lo, hi), {scale, scale});
+  const ValueRange b = times(shape_bounds(*this, lo, hi), {scale, scale});
   return illuminant ? times(b, d65_bounds(lo, hi)) : b;
 }
 
