@@ -247,11 +247,12 @@ TEST(Film, ScenesLitAtAnyScaleRenderAlike) {
 }
 
 TEST(MemoryEstimate, CountsTheFilmAndParsesSizes) {
-  const MemoryEstimate e = estimate_render_memory(100, 50, 2, 3, 4);
+  const MemoryEstimate e = estimate_render_memory(100, 50, 2, 3, 4, 0);
   EXPECT_EQ(e.film, 100.0 * 50 * (3 * 16 + 3 * sizeof(double) + sizeof(uint32_t)));
   EXPECT_EQ(e.image, 2 * 100.0 * 50 * 3 * sizeof(float));
   EXPECT_GT(e.octrees, 0);
-  EXPECT_EQ(e.total(), e.film + e.image + e.octrees + e.threads);
+  EXPECT_EQ(e.media_lists, 0);  // no index-matched media
+  EXPECT_EQ(e.total(), e.film + e.image + e.octrees + e.media_lists + e.threads);
   EXPECT_EQ(parse_memory_size("512"), 512u);
   EXPECT_EQ(parse_memory_size("2K"), 2048u);
   EXPECT_EQ(parse_memory_size("1.5G"), 1536ull << 20);

@@ -14,6 +14,7 @@
 #include "nimbus/math/rng.h"
 #include "nimbus/media/cloud_density.h"
 #include "nimbus/media/medium_field.h"
+#include "nimbus/render/memory_estimate.h"
 #include "nimbus/render/path_spectra.h"
 #include "nimbus/render/renderer.h"
 #include "nimbus/scene/compile.h"
@@ -185,6 +186,38 @@ TEST(ManyMedia, OverlappingCopiesRenderAsTheirSum) {
     // Power: the comparison sees the sum 20 % denser.
     const RenderResult denser = render(stacked(24, 1.2 / 24, mode));
     EXPECT_FALSE(test::film_chi2_blocks(one.film, denser.film, 2).passes());
+  }
+}
+
+// Copies of one object list every copy in every node, and splitting cannot shorten a list that
+// every member's bounds cover: the tree splits no deeper than requested (before, the nodes
+// listing all 24 split on to the node budget, 87 633 nodes built, which pruning then undid).
+TEST(ManyMedia, CopiesOfOneObjectSplitNoDeeperThanRequested) {
+  const Scene many = stacked(24, 1.0 / 24, TrackingSettings::Mode::Delta);
+  const int depth = many.settings.tracking.octree_depth;
+  size_t full = 0;  // the nodes of a full tree of that depth
+  for (int level = 0; level <= depth; ++level) full += size_t(1) << (3 * level);
+  EXPECT_LE(many.field_octree.built_nodes, full);
+  EXPECT_LE(many.field_octree.depth, depth);
+}
+
+// The memory estimate charges the field's lookup grid and its octree's member lists at caps that
+// grow with the number of objects: never less than what is built, and for thousands of puffs
+// megabytes, not the 2^24-entry caps of very large scenes.
+TEST(ManyMedia, TheMemoryEstimateBoundsTheListsBuilt) {
+  for (const int count : {1, 30, 3000}) {
+    SCOPED_TRACE(count);
+    const Scene scene = puffs(count, 6);
+    const MajorantOctree& tree = scene.field_octree;
+    const MemoryEstimate e = estimate_render_memory(8, 8, 1, 3, 1, scene.field_objects.size());
+    const double lists = double(tree.members.size() + tree.member_begin.size()) * 4;
+    EXPECT_LE(lists + double(scene.field_grid.bytes()), e.media_lists);
+    EXPECT_LE(double(tree.bytes()), e.octrees + e.media_lists);
+    EXPECT_LE(tree.nodes.size(), kOctreeMaxNodes);
+    EXPECT_LE(scene.field_grid.members.size(), member_grid_max_entries(size_t(count)));
+    if (count == 3000) {
+      EXPECT_LT(e.media_lists, 64.0 * (1 << 20));
+    }
   }
 }
 

@@ -250,26 +250,27 @@ void check_render_memory(const SceneDesc& desc, int threads, std::optional<uint6
   // octree.h), and is not charged the node budget (issue 26: 1 024 dielectric spheres of one
   // homogeneous medium were refused as needing 42 GiB).
   int octrees = 0;
-  bool field = false;
+  std::size_t field_objects = 0;
   for (const ObjectDesc& o : desc.objects) {
     const int medium = compiled_medium(o);
     if (has_own_octree(medium, o.surface.type))
       octrees += !desc.media[size_t(medium)].constant_density;
-    field = field || (medium >= 0 && !has_own_octree(medium, o.surface.type));
+    field_objects += medium >= 0 && !has_own_octree(medium, o.surface.type);
   }
-  octrees += field;
+  octrees += field_objects > 0;
   const int bins =
       desc.settings.spectral.mode == SpectralSettings::Mode::Spectral ? kSpectralBins : 3;
   const int workers = threads > 0 ? threads : int(std::thread::hardware_concurrency());
-  const MemoryEstimate need =
-      estimate_render_memory(desc.settings.width, desc.settings.height, octrees, bins, workers);
+  const MemoryEstimate need = estimate_render_memory(desc.settings.width, desc.settings.height,
+                                                     octrees, bins, workers, field_objects);
   const uint64_t limit = max_memory ? *max_memory : available_memory();
   if (limit > 0 && need.total() > double(limit))
     throw JobError(fmt::format(
-        "the render needs about {} (film {}, image {}, majorant octrees {}), more than the {} {}",
+        "the render needs about {} (film {}, image {}, majorant octrees {}{}), more than the {} {}",
         format_memory(need.total()), format_memory(need.film), format_memory(need.image),
-        format_memory(need.octrees), format_memory(double(limit)),
-        max_memory ? "allowed by --max-memory" : "available"));
+        format_memory(need.octrees),
+        need.media_lists > 0 ? ", media lists " + format_memory(need.media_lists) : "",
+        format_memory(double(limit)), max_memory ? "allowed by --max-memory" : "available"));
 }
 
 }  // namespace nimbus

@@ -17,10 +17,27 @@ std::array<int, 3> cells_for(const Vec3& extent, double target) {
   const double per_unit = std::cbrt(target / volume);
   for (int k = 0; k < 3; ++k)
     n[k] = std::clamp(static_cast<int>(std::ceil(per_unit * extent[k] / longest)), 1, 1 << 10);
+  // Rounding up, and a flat axis's single cell, can multiply the count; member_grid_max_bytes
+  // holds it to kMemberGridMaxCellsPerTarget times the target.
+  while (double(n[0]) * n[1] * n[2] > kMemberGridMaxCellsPerTarget * target) {
+    int& most = *std::max_element(n.begin(), n.end());
+    most = std::max(1, most / 2);
+  }
   return n;
 }
 
 }  // namespace
+
+std::size_t member_grid_max_bytes(std::size_t objects) {
+  if (objects == 0) return sizeof(MemberGrid);
+  const double cells = kMemberGridMaxCellsPerTarget * kMemberGridCellsPerObject * double(objects);
+  const double entries = double(member_grid_max_entries(objects));
+  // The cells' offsets twice (the count being filled, and the grid's copy), the entries, and
+  // the objects' bounds.
+  return sizeof(MemberGrid) +
+         std::size_t(2 * (cells + 1) * sizeof(std::uint32_t) + entries * sizeof(std::int32_t)) +
+         objects * sizeof(Box);
+}
 
 MemberGrid build_member_grid(std::span<const Box> bounds) {
   MemberGrid grid;
@@ -28,6 +45,7 @@ MemberGrid build_member_grid(std::span<const Box> bounds) {
   for (const Box& b : bounds) grid.box = unite(grid.box, b);
   if (grid.box.empty()) return grid;
   double target = std::max(1.0, kMemberGridCellsPerObject * double(bounds.size()));
+  const std::size_t max_entries = member_grid_max_entries(bounds.size());
   for (;;) {
     grid.cells = cells_for(grid.box.extent(), target);
     for (int k = 0; k < 3; ++k) {
@@ -53,9 +71,9 @@ MemberGrid build_member_grid(std::span<const Box> bounds) {
         ++count[c + 1];
         ++entries;
       });
-      if (entries > kMemberGridMaxEntries) break;
+      if (entries > max_entries) break;
     }
-    if (entries > kMemberGridMaxEntries && cells > 1) {
+    if (entries > max_entries && cells > 1) {
       target = double(cells) / 8;  // too many entries: coarser
       continue;
     }

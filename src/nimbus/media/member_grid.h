@@ -3,7 +3,7 @@
 // bounds whose cells list, in ascending order, the objects whose bounds meet them. A point's
 // lookup (medium_field.h) looks at its cell's objects only, so its cost follows the objects
 // near the point, not the number in the scene. The grid has about kMemberGridCellsPerObject
-// cells per object, coarser where the lists would exceed kMemberGridMaxEntries in all.
+// cells per object, coarser where the lists would exceed member_grid_max_entries in all.
 
 #include <array>
 #include <cstdint>
@@ -15,7 +15,16 @@
 namespace nimbus {
 
 inline constexpr double kMemberGridCellsPerObject = 16;
-inline constexpr std::size_t kMemberGridMaxEntries = std::size_t{1} << 24;
+// A grid has at most this many times its target of cells (kMemberGridCellsPerObject per object).
+inline constexpr double kMemberGridMaxCellsPerTarget = 2;
+
+// The most entries the cells' lists may hold in all for `objects` objects (puffs of similar
+// sizes list about 170 per object; 2^24 at most, 64 MiB); a grid that would hold more is made
+// coarser.
+constexpr std::size_t member_grid_max_entries(std::size_t objects) {
+  const std::size_t entries = (std::size_t{1} << 16) + 1024 * objects;
+  return entries < (std::size_t{1} << 24) ? entries : std::size_t{1} << 24;
+}
 
 struct MemberGrid {
   Box box;  // the union of the objects' bounds; empty: no objects
@@ -24,7 +33,6 @@ struct MemberGrid {
   std::vector<std::uint32_t> begin;  // cell c's objects: members[begin[c], begin[c + 1])
   std::vector<std::int32_t> members;
   std::vector<Box> bounds;  // object i's bounds, together: a lookup tests them before the objects
-
 
   std::size_t bytes() const {
     return sizeof(MemberGrid) + begin.size() * sizeof(std::uint32_t) +
@@ -40,6 +48,10 @@ struct MemberGrid {
 
 // The grid over `bounds` (object i's conservative bounds).
 MemberGrid build_member_grid(std::span<const Box> bounds);
+
+// The most memory that building the grid over `objects` objects takes, whatever their bounds:
+// what the memory estimate charges (render/memory_estimate.h).
+std::size_t member_grid_max_bytes(std::size_t objects);
 
 // The objects whose bounds may hold x, ascending (none outside the grid's box).
 inline std::span<const std::int32_t> members_at(const MemberGrid& grid, const Vec3& x) {

@@ -136,6 +136,23 @@ double crowding(const std::vector<std::int32_t>& list) {
   return list.size() > size_t(kOctreeMaxListed) ? double(list.size() - kOctreeMaxListed) : 0.0;
 }
 
+// The crowding that splitting the node can relieve: of its members, those whose bounds do not
+// cover its box (one that covers the box is listed by every child, however deep). The box is
+// shrunk by the margin of members_meeting: a node's faces, computed from its centre, may lie a
+// rounding outside the bounds that made the root's box.
+double relievable_crowding(const std::vector<Member>& all, const std::vector<std::int32_t>& list,
+                           const Box& box) {
+  if (list.size() <= size_t(kOctreeMaxListed)) return 0;
+  const Vec3 margin = box.extent() * 1e-6;
+  const Vec3 lo = box.lo + margin, hi = box.hi - margin;
+  size_t partial = 0;
+  for (const std::int32_t i : list) {
+    const Box& b = all[i].object->bounds;
+    partial += !(b.contains(lo) && b.contains(hi));
+  }
+  return partial > size_t(kOctreeMaxListed) ? double(partial - kOctreeMaxListed) : 0.0;
+}
+
 // The tree as built and the arrays that place its nodes, all in breadth-first order.
 struct Grown {
   std::vector<OctreeNode> nodes;
@@ -359,6 +376,8 @@ MajorantOctree build_majorant_octree(std::span<const Medium> media,
   g.levels.push_back(0);
   const int max_depth = std::clamp(settings.depth, 0, kOctreeMaxDepth);
   size_t begin = 0, end = 1;
+  size_t list_entries = g.lists[0].size();
+  const size_t max_entries = octree_max_list_entries(members.size());
   const double interval_share = settings.sampled ? 0.5 : 1.0;
   // Levels past the requested depth split only nodes that list too many objects.
   for (int level = 0; level < kOctreeMaxDepth; ++level) {
@@ -370,19 +389,30 @@ MajorantOctree build_majorant_octree(std::span<const Medium> media,
       size_t node;
     };
     std::vector<Candidate> split;
+    size_t new_entries = 0;  // at most, in the children's lists
     for (size_t i = begin; i < end; ++i) {
       const double* b = &g.bounds[2 * bins * i];
-      const bool crowded = !g.nodes[i].empty && crowding(g.lists[i]) > 0;
-      if ((level < max_depth && wants_split(g.nodes[i], b, bins, half)) || crowded)
-        split.push_back({null_optical_depth(b, bins, half) + crowding(g.lists[i]), i});
+      const double crowded =
+          g.nodes[i].empty ? 0.0
+                           : relievable_crowding(members, g.lists[i], box_of(g.centers[i], half));
+      if ((level < max_depth && wants_split(g.nodes[i], b, bins, half)) || crowded > 0) {
+        split.push_back({null_optical_depth(b, bins, half) + crowded, i});
+        new_entries += 8 * g.lists[i].size();
+      }
     }
     const size_t room = (kOctreeMaxNodes - g.nodes.size()) / 8;
-    if (split.size() > room) {
-      // Keep the nodes where splitting can save the most null collisions; ties by index.
+    if (split.size() > room || list_entries + new_entries > max_entries) {
+      // Keep the nodes where splitting can save the most null collisions, within the budgets of
+      // nodes and list entries; ties by index.
       std::sort(split.begin(), split.end(), [](const Candidate& a, const Candidate& b) {
         return a.priority != b.priority ? a.priority > b.priority : a.node < b.node;
       });
-      split.resize(room);
+      size_t kept = 0;
+      for (size_t entries = list_entries; kept < std::min(room, split.size()); ++kept) {
+        entries += 8 * g.lists[split[kept].node].size();
+        if (entries > max_entries) break;
+      }
+      split.resize(kept);
       std::sort(split.begin(), split.end(),
                 [](const Candidate& a, const Candidate& b) { return a.node < b.node; });
     }
@@ -404,9 +434,11 @@ MajorantOctree build_majorant_octree(std::span<const Medium> media,
                                        g.lists[parent], g.lists[first + k]);
       }
     });
+    for (size_t i = end; i < g.nodes.size(); ++i) list_entries += g.lists[i].size();
     begin = end;
     end = g.nodes.size();
   }
+  tree.built_nodes = g.nodes.size();
   g = prune(std::move(g), tree);
   tree.depth = *std::max_element(g.levels.begin(), g.levels.end());
   if (settings.sampled) {

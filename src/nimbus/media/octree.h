@@ -64,6 +64,15 @@ inline constexpr double kOctreeLookupCost = 4;
 // scene holds (issue 26), and scenes of at most this many media objects build as before.
 inline constexpr int kOctreeMaxListed = 8;
 inline constexpr double kOctreeListedCost = 0.5;
+// The most entries the nodes' member lists hold in all while the field's tree over `members`
+// objects is built (2^24 at most, 64 MiB): a level whose splits would pass it splits only the
+// nodes that gain the most. Never reached with at most kOctreeMaxListed members (every node at
+// the budget listing them all); puffs of similar sizes take about 40 per object.
+constexpr std::size_t octree_max_list_entries(std::size_t members) {
+  const std::size_t few = members < std::size_t(kOctreeMaxListed) ? members : kOctreeMaxListed;
+  const std::size_t entries = kOctreeMaxNodes * few + 256 * members;
+  return entries < (std::size_t{1} << 24) ? entries : std::size_t{1} << 24;
+}
 
 struct OctreeNode {
   // The first of 8 contiguous children, child k in octant (k & 1: upper x, k & 2: upper y,
@@ -94,6 +103,7 @@ struct MajorantOctree {
   std::vector<std::int32_t> members;
   int depth = 0;  // deepest level reached
   double build_seconds = 0;
+  std::size_t built_nodes = 0;  // before pruning: what the build held at its peak
   uint64_t sampled_points = 0;  // points looked up by the sampling pass (source "sample")
 
   const double* mu_bar(std::size_t node) const { return &bounds[2 * bins * node]; }

@@ -2,27 +2,38 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <fstream>
 #include <stdexcept>
+#include <vector>
 
 #include "nimbus/math/vec3.h"
+#include "nimbus/media/member_grid.h"
 #include "nimbus/media/octree.h"
 #include "nimbus/render/film.h"
 
 namespace nimbus {
 
-MemoryEstimate estimate_render_memory(int width, int height, int octrees, int bins, int threads) {
+MemoryEstimate estimate_render_memory(int width, int height, int octrees, int bins, int threads,
+                                      std::size_t field_objects) {
   const double pixels = double(width) * double(height);
   MemoryEstimate e;
   e.film = pixels * (sizeof(ExactRgb) + sizeof(Rgb) + sizeof(uint32_t));
   // The float image, and as much again for a writer's rows (EXR slices, PNG bytes).
   e.image = 2 * pixels * 3 * sizeof(float);
-  // At the node budget, while building: the node, its bounds, its centre and level, and the
-  // pruned copy.
-  const double per_node = sizeof(OctreeNode) + 2.0 * bins * sizeof(double) + sizeof(Vec3) + 4;
+  // At the node budget, while building: the node, its bounds, its centre, level and list of
+  // members (one, in a solid), and the pruned copy.
+  const double per_node = sizeof(OctreeNode) + 2.0 * bins * sizeof(double) + sizeof(Vec3) + 4 +
+                          sizeof(std::vector<std::int32_t>) + sizeof(std::int32_t);
   e.octrees = double(octrees) * double(kOctreeMaxNodes) * per_node * 2;
+  if (field_objects > 0) {
+    // The field octree's lists at their cap, and the leaves' copy.
+    const double entries = double(octree_max_list_entries(field_objects));
+    e.media_lists =
+        2 * entries * sizeof(std::int32_t) + double(member_grid_max_bytes(field_objects));
+  }
   e.threads = double(threads) * (1 << 20);
   return e;
 }

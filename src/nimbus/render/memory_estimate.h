@@ -3,6 +3,7 @@
 // so that a request the machine cannot hold is refused with one line instead of being killed
 // by the OS (a 16384 × 16384 film took 15.7 GB without a word).
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 
@@ -12,13 +13,17 @@ struct MemoryEstimate {
   double film = 0;     // per-pixel sums, sums of squares and counts
   double image = 0;    // the float image written from the film, and a writer's copy
   double octrees = 0;  // majorant octrees at their node budget, while being built
+  // The index-matched media's lookup grid and the field octree's lists of them, at their caps
+  double media_lists = 0;
   double threads = 0;  // per-thread state of the render
-  double total() const { return film + image + octrees + threads; }
+  double total() const { return film + image + octrees + media_lists + threads; }
 };
 
 // For an image of width × height, `octrees` majorant octrees (the field's and one per solid
-// holding a medium) with `bins` bounds each per node, rendered on `threads` threads.
-MemoryEstimate estimate_render_memory(int width, int height, int octrees, int bins, int threads);
+// holding a medium) with `bins` bounds each per node, `field_objects` index-matched objects
+// holding a medium, rendered on `threads` threads.
+MemoryEstimate estimate_render_memory(int width, int height, int octrees, int bins, int threads,
+                                      std::size_t field_objects);
 
 // The memory the system can still give (MemAvailable of /proc/meminfo), or 0 when unknown.
 std::uint64_t available_memory();

@@ -48,13 +48,14 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
   };
   // All octrees together: the field's and those inside solids.
   double build_seconds = 0;
-  size_t nodes = 0, bytes = 0;
+  size_t nodes = 0, built_nodes = 0, bytes = 0;
   uint64_t sampled = 0;
   int depth = 0;
   auto add = [&](const MajorantOctree& t) {
     build_seconds += t.build_seconds;
     sampled += t.sampled_points;
     nodes += t.nodes.size();
+    built_nodes += t.built_nodes;
     bytes += t.nodes.empty() ? 0 : t.bytes();
     depth = std::max(depth, t.depth);
   };
@@ -62,6 +63,7 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
   for (const MajorantOctree& t : scene.solid_octrees.trees) add(t);
   j["octree"] = {{"build_seconds", build_seconds},
                  {"nodes", nodes},
+                 {"built_nodes", built_nodes},
                  {"bytes", bytes},
                  {"depth_requested", scene.settings.tracking.octree_depth},
                  {"depth", depth},
