@@ -70,8 +70,18 @@ void for_each_medium_at(const S& scene, const Vec3& x, int inside, F&& f) {
   if constexpr (requires { scene.field_grid; }) {
     const MemberGrid& grid = scene.field_grid;
     if (!grid.begin.empty()) {
-      for (const std::int32_t k : members_at(grid, x))
-        if (grid.bounds[k].contains(x)) visit(scene.field_objects[k]);
+      for (const std::int32_t k : members_at(grid, x)) {
+        if (!grid.bounds[k].contains(x)) continue;
+        const GridQuadric& q = grid.quadrics[k];
+        if (!q.single) {
+          visit(scene.field_objects[k]);
+          continue;
+        }
+        const double F_x = q.quadric.eval(x);  // as evaluate(tape, x), to the bit
+        if (F_x <= 0) continue;
+        const double d = medium_density(scene.media[q.medium], x, F_x);
+        if (d > 0) f(q.medium, d);
+      }
       return;
     }
   }

@@ -33,15 +33,27 @@ std::size_t member_grid_max_bytes(std::size_t objects) {
   const double cells = kMemberGridMaxCellsPerTarget * kMemberGridCellsPerObject * double(objects);
   const double entries = double(member_grid_max_entries(objects));
   // The cells' offsets twice (the count being filled, and the grid's copy), the entries, and
-  // the objects' bounds.
+  // the objects' bounds and quadrics.
   return sizeof(MemberGrid) +
          std::size_t(2 * (cells + 1) * sizeof(std::uint32_t) + entries * sizeof(std::int32_t)) +
-         objects * sizeof(Box);
+         objects * (sizeof(Box) + sizeof(GridQuadric));
 }
 
-MemberGrid build_member_grid(std::span<const Box> bounds) {
+GridQuadric grid_quadric(const Tape& tape, int medium) {
+  GridQuadric g;
+  g.medium = medium;
+  // evaluate() runs the one instruction, r[0] = quadrics[i](p), and returns r[0]: the same value.
+  if (tape.code.size() == 1 && tape.code[0].op == Op::Quadric && tape.code[0].dst == 0) {
+    g.quadric = tape.quadrics[tape.code[0].quadric];
+    g.single = true;
+  }
+  return g;
+}
+
+MemberGrid build_member_grid(std::span<const Box> bounds, std::vector<GridQuadric> quadrics) {
   MemberGrid grid;
   grid.bounds.assign(bounds.begin(), bounds.end());
+  grid.quadrics = std::move(quadrics);
   for (const Box& b : bounds) grid.box = unite(grid.box, b);
   if (grid.box.empty()) return grid;
   double target = std::max(1.0, kMemberGridCellsPerObject * double(bounds.size()));

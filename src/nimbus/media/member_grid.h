@@ -10,6 +10,8 @@
 #include <span>
 #include <vector>
 
+#include "nimbus/frep/quadric.h"
+#include "nimbus/frep/tape.h"
 #include "nimbus/math/box.h"
 
 namespace nimbus {
@@ -26,6 +28,15 @@ constexpr std::size_t member_grid_max_entries(std::size_t objects) {
   return entries < (std::size_t{1} << 24) ? entries : std::size_t{1} << 24;
 }
 
+// Object k's function where it is one quadric (its tape a single instruction, as for a sphere or
+// an ellipsoid puff), with its medium: a lookup evaluates it here, beside the boxes, rather than
+// through the object and its tape, which a random point reaches from memory (issue 26).
+struct GridQuadric {
+  Quadric quadric;
+  std::int32_t medium = -1;
+  bool single = false;  // false: evaluate the object's tape
+};
+
 struct MemberGrid {
   Box box;  // the union of the objects' bounds; empty: no objects
   std::array<int, 3> cells{0, 0, 0};
@@ -33,10 +44,12 @@ struct MemberGrid {
   std::vector<std::uint32_t> begin;  // cell c's objects: members[begin[c], begin[c + 1])
   std::vector<std::int32_t> members;
   std::vector<Box> bounds;  // object i's bounds, together: a lookup tests them before the objects
+  std::vector<GridQuadric> quadrics;  // object i's single quadric, if it is one
 
   std::size_t bytes() const {
     return sizeof(MemberGrid) + begin.size() * sizeof(std::uint32_t) +
-           members.size() * sizeof(std::int32_t) + bounds.size() * sizeof(Box);
+           members.size() * sizeof(std::int32_t) + bounds.size() * sizeof(Box) +
+           quadrics.size() * sizeof(GridQuadric);
   }
   // The cell along axis k of coordinate v, clamped into the grid. Monotonic in v, so the
   // cells of an object's bounds hold every point inside them.
@@ -46,8 +59,11 @@ struct MemberGrid {
   }
 };
 
-// The grid over `bounds` (object i's conservative bounds).
-MemberGrid build_member_grid(std::span<const Box> bounds);
+// The grid over `bounds` (object i's conservative bounds), with each object's `quadrics`.
+MemberGrid build_member_grid(std::span<const Box> bounds, std::vector<GridQuadric> quadrics);
+
+// What a grid keeps of an object whose function is `tape` and whose medium is `medium`.
+GridQuadric grid_quadric(const Tape& tape, int medium);
 
 // The most memory that building the grid over `objects` objects takes, whatever their bounds:
 // what the memory estimate charges (render/memory_estimate.h).

@@ -168,8 +168,12 @@ void finish_scene(Scene& scene, const BuildMonitor& monitor) {
                     "are supported",
                     field_g.size(), kMaxPhaseLobes));
   std::vector<Box> field_bounds;
-  for (int i : scene.field_objects) field_bounds.push_back(scene.objects[i].bounds);
-  scene.field_grid = build_member_grid(field_bounds);
+  std::vector<GridQuadric> field_quadrics;
+  for (int i : scene.field_objects) {
+    field_bounds.push_back(scene.objects[i].bounds);
+    field_quadrics.push_back(grid_quadric(scene.objects[i].tape, scene.objects[i].medium));
+  }
+  scene.field_grid = build_member_grid(field_bounds, std::move(field_quadrics));
   if (!all.empty()) scene.scale = length(all.extent());
   scene.surfaces = build_surface_index(scene.objects, scene.lights);
   complete_spectra(scene);
