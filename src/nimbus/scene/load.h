@@ -33,7 +33,10 @@ inline constexpr std::uintmax_t kMaxSceneFileBytes = std::uintmax_t{64} << 20;
 // (issue 29: a camera 1e200 away was "parallel to up", a sphere there "unbounded").
 inline constexpr double kMaxCoordinate = 1e100;
 inline const Range kCoordinate = between(-kMaxCoordinate, kMaxCoordinate);
-inline const Range kLength = Range{0.0, kMaxCoordinate, true, false};
+// Lengths are at least 1e-100, whose square is a normal double (issue 26: a sphere of radius
+// 1e-320 squared it to 0 and was an object of no size, rendered as nothing without a word).
+inline constexpr double kMinLength = 1e-100;
+inline const Range kLength = between(kMinLength, kMaxCoordinate);
 
 // Emitted light (a light's radiance, irradiance or intensity, a surface's or a medium's radiance,
 // a blackbody's or a temperature grid's scale) lies within [0, 1e30]: a film sums light of any
