@@ -1,8 +1,10 @@
 #include "nimbus/scene/compile.h"
 
 #include <fmt/format.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <exception>
 #include <stdexcept>
 
 #include "nimbus/frep/bounds.h"
@@ -96,13 +98,29 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
   for (const MediumDesc& md : desc.media) scene.media.push_back(compile_medium(md, read));
   if (inputs) *inputs = std::move(read);
 
-  std::vector<double> field_g;                  // the different anisotropies of index-matched media
-  std::vector<const ObjectDesc*> object_descs;  // of each compiled object, for messages
-  for (const ObjectDesc& od : desc.objects) {
-    SceneObject obj;
+  // The objects' tapes and bounds in parallel (a free form's tight bounds take about 1.5 ms),
+  // the rest in the objects' order: a scene compiles to the same objects, and fails with the
+  // same first error, whatever the number of threads.
+  std::vector<Tape> tapes(desc.objects.size());
+  std::vector<std::exception_ptr> failed(desc.objects.size());
+  tbb::parallel_for(std::size_t{0}, desc.objects.size(), [&](std::size_t k) {
+    const ObjectDesc& od = desc.objects[k];
     const int medium = compiled_medium(od);
     const bool reads_F = medium >= 0 && scene.media[medium].density->uses_F();
-    obj.tape = compile(*od.shape, reads_F ? FUse::Value : FUse::Sign);
+    try {
+      tapes[k] = compile(*od.shape, reads_F ? FUse::Value : FUse::Sign);
+    } catch (...) {
+      failed[k] = std::current_exception();
+    }
+  });
+  std::vector<double> field_g;                  // the different anisotropies of index-matched media
+  std::vector<const ObjectDesc*> object_descs;  // of each compiled object, for messages
+  for (std::size_t k = 0; k < desc.objects.size(); ++k) {
+    const ObjectDesc& od = desc.objects[k];
+    if (failed[k]) std::rethrow_exception(failed[k]);
+    SceneObject obj;
+    const int medium = compiled_medium(od);
+    obj.tape = std::move(tapes[k]);
     const Bounds& b = obj.tape.bounds;  // compile() computed them
     if (!b.bounded)
       throw SceneError(fmt::format(
