@@ -328,8 +328,8 @@ int run_render(const RenderArgs& args, const Cluster& cluster) {
   if (lead && step.code == 0) step = attempt([&] { job.check(); });
   if (const int code = agree(cluster, step); code != 0) return code;
 
-  // The majorant octrees can take seconds to build (deep trees, sampled bounds): they get a
-  // bar of their own, and a signal stops them too.
+  // Compiling can take seconds (many free forms; deep octrees, sampled bounds): the octrees get
+  // a bar of their own, and a signal stops the objects' compile and the octrees' build too.
   BuildMonitor monitor;
   monitor.cancel = options.cancel;
   if (show_progress) monitor.progress = progress_bar("octrees");
@@ -338,7 +338,7 @@ int run_render(const RenderArgs& args, const Cluster& cluster) {
   if (show_progress) std::fprintf(stderr, "\n");
   if (step.code == 0 && !compiled) {
     const int sig = g_signal.load();
-    step = {128 + sig, fmt::format("nimbus: stopped by {} while building the majorant octrees; "
+    step = {128 + sig, fmt::format("nimbus: stopped by {} while compiling the scene; "
                                    "nothing written",
                                    signal_name(sig))};
   }

@@ -349,7 +349,7 @@ TEST_F(Cli, SignalsStopTheOctreeBuildAndWriteNothing) {
   std::stringstream err;
   err << err_file.rdbuf();
   EXPECT_EQ(err.str(),
-            "nimbus: stopped by SIGINT while building the majorant octrees; nothing written\n");
+            "nimbus: stopped by SIGINT while compiling the scene; nothing written\n");
   fs::remove(dir_ / "code.txt");
   fs::remove(dir_ / "err.txt");
   EXPECT_TRUE(outputs().empty());

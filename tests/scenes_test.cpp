@@ -66,5 +66,18 @@ TEST(Scenes, ObjectsCompileTheSameOnOneThreadAsOnMany) {
   }
 }
 
+// A cancel (Ctrl-C in the command line) stops the objects' compile, not only the octrees'
+// build that follows it: cancelled from the start, no object is compiled.
+TEST(Scenes, ACancelStopsTheObjectsCompile) {
+  const SceneDesc desc =
+      load_scene_file(std::string(NIMBUS_SOURCE_DIR) + "/scenes/lanterns.json", {});
+  BuildMonitor stop;
+  stop.cancel = [] { return true; };
+  EXPECT_TRUE(compile_scene(desc, stop).objects.empty());
+  BuildMonitor never;
+  never.cancel = [] { return false; };
+  EXPECT_EQ(compile_scene(desc, never).objects.size(), desc.objects.size());
+}
+
 }  // namespace scenes_test
 }  // namespace nimbus

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "nimbus/frep/bounds.h"
+#include "nimbus/media/build_monitor.h"
 #include "nimbus/media/medium_field.h"
 #include "nimbus/media/octree.h"
 #include "nimbus/scene/load.h"
@@ -103,7 +104,10 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
   // same first error, whatever the number of threads.
   std::vector<Tape> tapes(desc.objects.size());
   std::vector<std::exception_ptr> failed(desc.objects.size());
+  BuildWatch watch(
+      monitor);  // a cancel (Ctrl-C) stops this part too: 10^5 free forms take a minute
   tbb::parallel_for(std::size_t{0}, desc.objects.size(), [&](std::size_t k) {
+    if (watch.cancelled()) return;
     const ObjectDesc& od = desc.objects[k];
     const int medium = compiled_medium(od);
     const bool reads_F = medium >= 0 && scene.media[medium].density->uses_F();
@@ -113,6 +117,7 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
       failed[k] = std::current_exception();
     }
   });
+  if (watch.cancelled()) return scene;          // not to be rendered
   std::vector<double> field_g;                  // the different anisotropies of index-matched media
   std::vector<const ObjectDesc*> object_descs;  // of each compiled object, for messages
   for (std::size_t k = 0; k < desc.objects.size(); ++k) {
