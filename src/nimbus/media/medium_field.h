@@ -59,28 +59,23 @@ void for_each_medium_at(const S& scene, const Vec3& x, int inside, F&& f) {
     if (d > 0) f(obj.medium, d);
     return;
   }
-  // Object i, whose bounds hold x.
-  auto visit = [&](int i) {
-    const auto& obj = scene.objects[i];
-    const double F_x = evaluate(obj.tape, x);
+  // The medium of an object whose bounds hold x and whose F there is F_x.
+  auto add = [&](int medium, double F_x) {
     if (F_x <= 0) return;
-    const double d = medium_density(scene.media[obj.medium], x, F_x);
-    if (d > 0) f(obj.medium, d);
+    const double d = medium_density(scene.media[medium], x, F_x);
+    if (d > 0) f(medium, d);
   };
+  auto visit = [&](int i) { add(scene.objects[i].medium, evaluate(scene.objects[i].tape, x)); };
   if constexpr (requires { scene.field_grid; }) {
     const MemberGrid& grid = scene.field_grid;
     if (!grid.begin.empty()) {
       for (const std::int32_t k : members_at(grid, x)) {
         if (!grid.bounds[k].contains(x)) continue;
         const GridQuadric& q = grid.quadrics[k];
-        if (!q.single) {
+        if (q.single)
+          add(q.medium, q.quadric.eval(x));  // as evaluate(tape, x), to the bit
+        else
           visit(scene.field_objects[k]);
-          continue;
-        }
-        const double F_x = q.quadric.eval(x);  // as evaluate(tape, x), to the bit
-        if (F_x <= 0) continue;
-        const double d = medium_density(scene.media[q.medium], x, F_x);
-        if (d > 0) f(q.medium, d);
       }
       return;
     }

@@ -136,6 +136,10 @@ double crowding(const std::vector<std::int32_t>& list) {
   return list.size() > size_t(kOctreeMaxListed) ? double(list.size() - kOctreeMaxListed) : 0.0;
 }
 
+// A node's box grown or shrunk by this fraction of its size: its faces, computed from its
+// centre, may lie a rounding off its parent's mid-plane or off the bounds that made the root.
+constexpr double kNodeMargin = 1e-6;
+
 // The crowding that splitting the node can relieve: of its members, those whose bounds do not
 // cover its box (one that covers the box is listed by every child, however deep). The box is
 // shrunk by the margin of members_meeting: a node's faces, computed from its centre, may lie a
@@ -143,7 +147,7 @@ double crowding(const std::vector<std::int32_t>& list) {
 double relievable_crowding(const std::vector<Member>& all, const std::vector<std::int32_t>& list,
                            const Box& box) {
   if (list.size() <= size_t(kOctreeMaxListed)) return 0;
-  const Vec3 margin = box.extent() * 1e-6;
+  const Vec3 margin = box.extent() * kNodeMargin;
   const Vec3 lo = box.lo + margin, hi = box.hi - margin;
   size_t partial = 0;
   for (const std::int32_t i : list) {
@@ -169,7 +173,7 @@ struct Grown {
 // point's descent (members_at) or a ray's stretch may lie on either side of that plane.
 std::vector<std::int32_t> members_meeting(const std::vector<Member>& all,
                                           std::span<const std::int32_t> parent, const Box& box) {
-  const Vec3 margin = box.extent() * 1e-6;
+  const Vec3 margin = box.extent() * kNodeMargin;
   const Box grown{box.lo - margin, box.hi + margin};
   std::vector<std::int32_t> out;
   for (const std::int32_t i : parent)
