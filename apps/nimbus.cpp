@@ -105,6 +105,20 @@ std::function<void(double)> progress_bar(const char* what) {
   };
 }
 
+// The objects' compile's bar: drawn only once it has taken half a second (most scenes compile
+// faster), on a line of its own.
+std::function<void(double)> objects_bar() {
+  const auto start = std::chrono::steady_clock::now();
+  return [start, drawn = false](double f) mutable {
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!drawn && elapsed < 0.5) return;
+    drawn = true;
+    print_progress("objects", f, elapsed);
+    if (f >= 1) std::fprintf(stderr, "\n");
+  };
+}
+
 // A step's outcome: exit code 0 (go on), or the code and the one line to print.
 struct Outcome {
   int code = 0;
@@ -332,7 +346,10 @@ int run_render(const RenderArgs& args, const Cluster& cluster) {
   // a bar of their own, and a signal stops the objects' compile and the octrees' build too.
   BuildMonitor monitor;
   monitor.cancel = options.cancel;
-  if (show_progress) monitor.progress = progress_bar("octrees");
+  if (show_progress) {
+    monitor.objects = objects_bar();
+    monitor.progress = progress_bar("octrees");
+  }
   bool compiled = false;
   step = attempt([&] { compiled = job.compile(monitor); });
   if (show_progress) std::fprintf(stderr, "\n");
@@ -490,6 +507,7 @@ int run_export_vdb(const ExportArgs& args) {
     desc.settings.tracking.majorant_source = TrackingSettings::MajorantSource::Bound;
     std::vector<InputFile> read;
     scene = compile_scene(desc, {}, &read);
+    object = vdb_export_compiled(scene, object);
     try {
       check_outputs_distinct({{"-o", args.output}}, scene_inputs(args.scene, read));
     } catch (const std::runtime_error& e) {

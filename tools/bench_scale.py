@@ -12,8 +12,11 @@ and the table gains the ratio A/B of samples per second.
   puffs:   N index-matched spheres of one medium (constant density, or --cloud) on a square
            grid over a floor, each overlapping its neighbours, 96 x 64 pixels, 4 spp.
 
+  --instances: the objects' or puffs' copies are one object's instances, from a .npy side file
+               (docs/scene-format.md), as a million of them must be.
+
 Usage: tools/bench_scale.py objects|lights|puffs N[,N...] ROUNDS NIMBUS [NIMBUS_B] [--freeform]
-       [--cloud]
+       [--cloud] [--instances]
 """
 import json
 import math
@@ -32,7 +35,17 @@ def grid(n, half):
     return [(-half + step * (i % k + 0.5), -half + step * (i // k + 0.5)) for i in range(n)], step
 
 
-def objects_scene(n, freeform):
+def write_placements(path, placements):
+    """(scale, x, y, z) per copy as an (N, 3, 4) .npy of affine rows (docs/scene-format.md)."""
+    import numpy  # only --instances needs it (Debian's python3-numpy)
+    m = numpy.zeros((len(placements), 3, 4))
+    p = numpy.array(placements, dtype=float).reshape(-1, 4)
+    m[:, 0, 0] = m[:, 1, 1] = m[:, 2, 2] = p[:, 0]
+    m[:, :, 3] = p[:, 1:]
+    numpy.save(path, m)
+
+
+def objects_scene(n, freeform, instances=None):
     points, step = grid(n, 4.0)
     r = 0.4 * step
     shapes = {"floor": {"type": "box", "min": [-6, -1, -6], "max": [6, 0, 6]}}
@@ -44,6 +57,14 @@ def objects_scene(n, freeform):
                                "weight": w}
                               for c, w in (([0.8, 0.3, 0], 2), ([-0.5, 0.6, 0.4], -3),
                                            ([0.1, -0.7, 0.6], 2), ([0, 0.2, -0.9], -2))]}
+    if instances:
+        # One object whose copies sit in a .npy side file: the shape is compiled once.
+        if not freeform:
+            shapes["rock"] = {"type": "sphere", "radius": 1}
+        write_placements(instances, [(r, x, r, z) for x, z in points])
+        objects.append({"shape": "rock", "surface": {"type": "diffuse", "albedo": 0.7},
+                        "instances": {"file": os.path.basename(instances)}})
+        points = []
     for x, z in points:
         if freeform:
             shape = {"type": "union", "transform": [{"scale": r}, {"translate": [x, r, z]}],
@@ -72,15 +93,20 @@ def lights_scene(n):
             "objects": [{"shape": "floor", "surface": {"type": "diffuse", "albedo": 0.5}}]}
 
 
-def puffs_scene(n, cloud):
+def puffs_scene(n, cloud, instances=None):
     points, step = grid(n, 4.0)
     r = 0.7 * step  # a puff reaches into its neighbours
     medium = {"sigma_a": 0.1 / r, "sigma_s": 2 / r, "phase": {"type": "hg", "g": 0.6}}
     if cloud:
         medium["density"] = {"type": "cloud", "frequency": 1 / r}
     objects = [{"shape": "floor", "surface": {"type": "diffuse", "albedo": 0.5}}]
-    objects += [{"shape": {"type": "sphere", "center": [x, r, z], "radius": r},
-                 "surface": {"type": "none"}, "medium": "puff"} for x, z in points]
+    if instances:
+        write_placements(instances, [(r, x, r, z) for x, z in points])
+        objects.append({"shape": {"type": "sphere", "radius": 1}, "surface": {"type": "none"},
+                        "medium": "puff", "instances": {"file": os.path.basename(instances)}})
+    else:
+        objects += [{"shape": {"type": "sphere", "center": [x, r, z], "radius": r},
+                     "surface": {"type": "none"}, "medium": "puff"} for x, z in points]
     return {"film": {"width": 96, "height": 64},
             "camera": {"from": [0, 7, 9], "to": [0, 0, 0], "fov": 50},
             "integrator": {"spp": 4, "max_depth": 4},
@@ -108,6 +134,7 @@ def run(nimbus, scene, out):
 def main():
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
     freeform, cloud = "--freeform" in sys.argv, "--cloud" in sys.argv
+    copies = "--instances" in sys.argv
     kind, counts, rounds = args[0], [int(n) for n in args[1].split(",")], int(args[2])
     binaries = args[3:]
     out = tempfile.mkdtemp()
@@ -118,10 +145,11 @@ def main():
     print(header + (" | A/B samples/s |" if len(binaries) == 2 else " |"))
     for n in counts:
         scene = os.path.join(out, f"{kind}_{n}.json")
+        npy = os.path.join(out, f"{kind}_{n}.npy") if copies else None
         with open(scene, "w") as f:
-            json.dump({"objects": lambda: objects_scene(n, freeform),
+            json.dump({"objects": lambda: objects_scene(n, freeform, npy),
                        "lights": lambda: lights_scene(n),
-                       "puffs": lambda: puffs_scene(n, cloud)}[kind](), f)
+                       "puffs": lambda: puffs_scene(n, cloud, npy)}[kind](), f)
         results = [[] for _ in binaries]
         for _ in range(rounds):
             for i, b in enumerate(binaries):

@@ -173,4 +173,22 @@ Bounds compute_bounds(const Tape& tape) {
   return {tight, true};
 }
 
+Bounds placed_bounds(const Tape& tape, const Bounds& local, const Mat4& placement) {
+  if (!local.bounded || local.box.empty()) return local;
+  Box placed;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Vec3 p{corner & 1 ? local.box.hi.x : local.box.lo.x,
+                 corner & 2 ? local.box.hi.y : local.box.lo.y,
+                 corner & 4 ? local.box.hi.z : local.box.lo.z};
+    placed = unite(placed, Box{transform_point(placement, p), transform_point(placement, p)});
+  }
+  // A relative 1e-12 covers the transform's round-off (a few ulps of the largest coordinate).
+  const double reach =
+      std::max({std::abs(placed.lo.x), std::abs(placed.lo.y), std::abs(placed.lo.z),
+                std::abs(placed.hi.x), std::abs(placed.hi.y), std::abs(placed.hi.z)});
+  const double pad = 1e-12 * (reach + length(placed.extent())) + 1e-300;
+  placed = {placed.lo - Vec3{pad, pad, pad}, placed.hi + Vec3{pad, pad, pad}};
+  return {intersect(placed, combined_box(tape)), true};
+}
+
 }  // namespace nimbus

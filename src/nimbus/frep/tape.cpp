@@ -171,12 +171,15 @@ std::size_t count_quadrics(const ShapeDesc& shape, std::size_t cap) {
   return count_quadrics(shape, cap, memo);
 }
 
-Tape compile(const ShapeDesc& shape, FUse use) {
+namespace {
+
+// compile() up to the bounds, with the shape placed by `placement`.
+Tape compile_code(const ShapeDesc& shape, const Mat4& placement, FUse use) {
   if (count_quadrics(shape) > kMaxTapeQuadrics)
     throw std::invalid_argument("compile: more than " + std::to_string(kMaxTapeQuadrics) +
                                 " quadrics in one shape");
   Tape tape;
-  Compiler(tape, use).emit(shape, Mat4::identity(), 0);
+  Compiler(tape, use).emit(shape, placement, 0);
   tape.only_cubed = only_cubed(tape);
   tape.cull_box.assign(tape.quadrics.size(), Box::everything());
   for (size_t i = 0; i < tape.quadrics.size(); ++i)
@@ -185,10 +188,29 @@ Tape compile(const ShapeDesc& shape, FUse use) {
   tape.kind = classify(tape.code);
   if (tape.kind == TapeKind::FlatFreeForm)
     for (size_t k = 2; k < tape.code.size(); k += 2) tape.weights.push_back(tape.code[k].weight);
-  tape.bounds = compute_bounds(tape);
+  return tape;
+}
+
+void set_bounds(Tape& tape, const Bounds& bounds) {
+  tape.bounds = bounds;
   tape.search_box = search_box(tape.bounds);
   const double diagonal = length(tape.search_box.extent());
   tape.size = std::isfinite(diagonal) && diagonal > 0 ? diagonal : 1.0;
+}
+
+}  // namespace
+
+Tape compile(const ShapeDesc& shape, FUse use) {
+  Tape tape = compile_code(shape, Mat4::identity(), use);
+  set_bounds(tape, compute_bounds(tape));
+  return tape;
+}
+
+Tape compile_placed(const ShapeDesc& shape, const Mat4& placement, FUse use, const Bounds& local) {
+  Tape tape = compile_code(shape, placement, use);
+  // One quadric's box is exact and cheap (no search): the same bounds as compile's.
+  set_bounds(tape, tape.kind == TapeKind::SingleQuadric ? compute_bounds(tape)
+                                                        : placed_bounds(tape, local, placement));
   return tape;
 }
 

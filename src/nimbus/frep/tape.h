@@ -96,6 +96,12 @@ enum class FUse { Value, Sign };
 // scene loader checks it).
 Tape compile(const ShapeDesc& shape, FUse use = FUse::Value);
 
+// compile(shape) placed by `placement` (applied after the shape's own transform; the same tape,
+// bit for bit, as compile of the shape wrapped in that transform: only the coefficients
+// transform), with bounds carried from `local`, the unplaced shape's (placed_bounds in
+// bounds.h) instead of searched: a shape used by many objects is searched once.
+Tape compile_placed(const ShapeDesc& shape, const Mat4& placement, FUse use, const Bounds& local);
+
 double evaluate(const Tape& tape, const Vec3& p);     // F(p), > 0 inside
 Vec3 gradient(const Tape& tape, const Vec3& p);       // ∇F(p), forward mode; points inward
 Interval evaluate(const Tape& tape, const Box& box);  // encloses F over the box

@@ -60,7 +60,18 @@ int vdb_export_object(const SceneDesc& desc, int requested) {
   if (desc.objects[requested].medium < 0)
     throw std::invalid_argument(fmt::format("--object {}: {}: {} holds no medium", requested,
                                             desc.source, desc.objects[requested].json_path));
+  if (desc.objects[requested].instances)
+    throw std::invalid_argument(
+        fmt::format("--object {}: {}: {} has instances; export one object (without \"instances\")",
+                    requested, desc.source, desc.objects[requested].json_path));
   return requested;
+}
+
+int vdb_export_compiled(const Scene& scene, int object) {
+  for (std::size_t i = 0; i < scene.objects.size(); ++i)
+    if (scene.objects[i].source == object) return int(i);
+  throw std::invalid_argument(
+      fmt::format("--object {}: the object holds nothing (its shape is empty)", object));
 }
 
 double vdb_export_voxels(const Scene& scene, int object, double h) {

@@ -37,6 +37,10 @@ struct VdbExportResult {
 // such object or it holds no medium.
 int vdb_export_object(const SceneDesc& desc, int requested);
 
+// The compiled scene's index of the description's object `object` (SceneObject::source); throws
+// std::invalid_argument when compiling dropped it (an empty shape).
+int vdb_export_compiled(const Scene& scene, int object);
+
 // The number of voxel centres i H inside the object's bounds.
 double vdb_export_voxels(const Scene& scene, int object, double voxel_size);
 

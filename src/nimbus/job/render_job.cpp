@@ -6,6 +6,7 @@
 #include <memory>
 #include <thread>
 
+#include "nimbus/frep/tape.h"
 #include "nimbus/job/fingerprint.h"
 #include "nimbus/job/shared_render.h"
 #include "nimbus/render/memory_estimate.h"
@@ -243,33 +244,44 @@ std::vector<NamedFile> RenderJob::files_written() const {
   return {};
 }
 
+double object_memory(const SceneDesc& desc) {
+  double bytes = 0;
+  for (const ObjectDesc& o : desc.objects)
+    bytes += object_memory(o.copies(), count_quadrics(*o.shape));
+  return bytes;
+}
+
 void check_render_memory(const SceneDesc& desc, int threads, std::optional<uint64_t> max_memory) {
   // One per solid holding a medium, and the field's if an index-matched object holds one
   // (render/scene.h); none for a scene without media (issue 29: 42 MiB were charged for it). A
   // solid of constant density is homogeneous: its octree is one node, never split (media/
   // octree.h), and is not charged the node budget (issue 26: 1 024 dielectric spheres of one
   // homogeneous medium were refused as needing 42 GiB).
-  int octrees = 0;
+  std::size_t octrees = 0;
   std::size_t field_objects = 0;
   for (const ObjectDesc& o : desc.objects) {
     const int medium = compiled_medium(o);
     if (has_own_octree(medium, o.surface.type))
-      octrees += !desc.media[size_t(medium)].constant_density;
-    field_objects += medium >= 0 && !has_own_octree(medium, o.surface.type);
+      octrees += o.copies() * !desc.media[size_t(medium)].constant_density;
+    if (medium >= 0 && !has_own_octree(medium, o.surface.type)) field_objects += o.copies();
   }
   octrees += field_objects > 0;
   const int bins =
       desc.settings.spectral.mode == SpectralSettings::Mode::Spectral ? kSpectralBins : 3;
   const int workers = threads > 0 ? threads : int(std::thread::hardware_concurrency());
-  const MemoryEstimate need = estimate_render_memory(desc.settings.width, desc.settings.height,
-                                                     octrees, bins, workers, field_objects);
+  MemoryEstimate need = estimate_render_memory(desc.settings.width, desc.settings.height, octrees,
+                                               bins, workers, field_objects);
+  need.objects = object_memory(desc);
   const uint64_t limit = max_memory ? *max_memory : available_memory();
   if (limit > 0 && need.total() > double(limit))
     throw JobError(fmt::format(
-        "the render needs about {} (film {}, image {}, majorant octrees {}{}), more than the {} {}",
+        "the render needs about {} (film {}, image {}, majorant octrees {}{}{}), more than the "
+        "{} {}",
         format_memory(need.total()), format_memory(need.film), format_memory(need.image),
         format_memory(need.octrees),
         need.media_lists > 0 ? ", media lists " + format_memory(need.media_lists) : "",
+        // Only where they count: most scenes' objects take kilobytes.
+        need.objects >= (1 << 20) ? ", objects " + format_memory(need.objects) : "",
         format_memory(double(limit)), max_memory ? "allowed by --max-memory" : "available"));
 }
 

@@ -133,4 +133,8 @@ class RenderJob {
 // (solid_octree_count).
 void check_render_memory(const SceneDesc& desc, int threads, std::optional<uint64_t> max_memory);
 
+// What the description's objects take once compiled, every instance counted (object_memory in
+// render/memory_estimate.h).
+double object_memory(const SceneDesc& desc);
+
 }  // namespace nimbus

@@ -16,8 +16,8 @@
 
 namespace nimbus {
 
-MemoryEstimate estimate_render_memory(int width, int height, int octrees, int bins, int threads,
-                                      std::size_t field_objects) {
+MemoryEstimate estimate_render_memory(int width, int height, std::size_t octrees, int bins,
+                                      int threads, std::size_t field_objects) {
   const double pixels = double(width) * double(height);
   MemoryEstimate e;
   e.film = pixels * (sizeof(ExactRgb) + sizeof(Rgb) + sizeof(uint32_t));
@@ -36,6 +36,10 @@ MemoryEstimate estimate_render_memory(int width, int height, int octrees, int bi
   }
   e.threads = double(threads) * (1 << 20);
   return e;
+}
+
+double object_memory(std::size_t copies, std::size_t quadrics) {
+  return double(copies) * (1400.0 + 320.0 * double(quadrics));
 }
 
 std::uint64_t available_memory() {

@@ -174,7 +174,7 @@ void build_majorant_octrees(Scene& scene, const BuildMonitor& monitor) {
   // Each tree gets an equal share of the progress: their costs are not known in advance.
   const double trees = double(solids.size() + 1);
   auto part = [&](size_t k) {
-    BuildMonitor m{nullptr, monitor.cancel};
+    BuildMonitor m{nullptr, monitor.cancel, nullptr};
     if (monitor.progress)
       m.progress = [&monitor, k, trees](double f) { monitor.progress((double(k) + f) / trees); };
     return m;

@@ -70,6 +70,9 @@ struct SceneObject {
   Box bounds;  // finite, conservative
   Surface surface;
   int medium = -1;
+  // The index of the description's object it comes from (one of its instances), or -1 for an
+  // object built in code.
+  int source = -1;
 };
 
 // Whether an object holding `medium` (an index, or -1) with a surface of this type has a majorant

@@ -1,9 +1,12 @@
 #include "nimbus/scene/compile.h"
 
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cmath>
 #include <exception>
 #include <stdexcept>
 
@@ -97,57 +100,102 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
   scene.camera = compile_camera(desc.camera, desc.settings);
 
   for (const MediumDesc& md : desc.media) scene.media.push_back(compile_medium(md, read));
-  if (inputs) *inputs = std::move(read);
+  if (inputs) {
+    *inputs = desc.inputs;
+    inputs->insert(inputs->end(), read.begin(), read.end());
+  }
 
-  // The objects' tapes and bounds in parallel (a free form's tight bounds take about 1.5 ms),
-  // the rest in the objects' order: a scene compiles to the same objects, and fails with the
-  // same first error, whatever the number of threads.
-  std::vector<Tape> tapes(desc.objects.size());
-  std::vector<std::exception_ptr> failed(desc.objects.size());
-  BuildWatch watch(
-      monitor);  // a cancel (Ctrl-C) stops this part too: 10^5 free forms take a minute
-  tbb::parallel_for(std::size_t{0}, desc.objects.size(), [&](std::size_t k) {
-    if (watch.cancelled()) return;
-    const ObjectDesc& od = desc.objects[k];
+  // Each object stands for its copies (its instances, or itself once). Their tapes and bounds
+  // compile in parallel: first the shapes of objects with instances, unplaced, whose bounds the
+  // search finds once (a free form's take about 1.5 ms), then every copy, placed by transforming
+  // only the coefficients. The rest follows in the objects' order: a scene compiles to the same
+  // objects, and fails with the same first error, whatever the number of threads.
+  std::vector<std::size_t> first(desc.objects.size() + 1, 0);  // each object's first copy
+  for (std::size_t k = 0; k < desc.objects.size(); ++k)
+    first[k + 1] = first[k] + desc.objects[k].copies();
+  const std::size_t copies = first.back();
+  const auto use = [&](const ObjectDesc& od) {
     const int medium = compiled_medium(od);
-    const bool reads_F = medium >= 0 && scene.media[medium].density->uses_F();
+    return medium >= 0 && scene.media[medium].density->uses_F() ? FUse::Value : FUse::Sign;
+  };
+  const BuildMonitor objects_monitor{monitor.objects, monitor.cancel, nullptr};
+  BuildWatch watch(objects_monitor);  // a cancel (Ctrl-C) stops this part too
+  std::vector<Tape> unplaced(desc.objects.size());
+  std::vector<std::exception_ptr> failed(copies);
+  tbb::parallel_for(std::size_t{0}, desc.objects.size(), [&](std::size_t k) {
+    const ObjectDesc& od = desc.objects[k];
+    if (!od.instances || watch.cancelled()) return;
     try {
-      tapes[k] = compile(*od.shape, reads_F ? FUse::Value : FUse::Sign);
+      unplaced[k] = compile(*od.shape, use(od));
     } catch (...) {
-      failed[k] = std::current_exception();
+      failed[first[k]] = std::current_exception();
     }
   });
-  if (watch.cancelled()) return scene;          // not to be rendered
-  std::vector<double> field_g;                  // the different anisotropies of index-matched media
-  std::vector<const ObjectDesc*> object_descs;  // of each compiled object, for messages
+  std::vector<Tape> tapes(copies);
+  std::atomic<std::size_t> done{0};
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, copies), [&](const auto& range) {
+    if (watch.cancelled()) return;
+    std::size_t k =
+        std::size_t(std::upper_bound(first.begin(), first.end(), range.begin()) - first.begin()) -
+        1;
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      while (i >= first[k + 1]) ++k;
+      const ObjectDesc& od = desc.objects[k];
+      if (od.instances && failed[first[k]]) continue;
+      try {
+        tapes[i] = od.instances ? compile_placed(*od.shape, (*od.instances)[i - first[k]], use(od),
+                                                 unplaced[k].bounds)
+                                : compile(*od.shape, use(od));
+      } catch (...) {
+        failed[i] = std::current_exception();
+      }
+    }
+    // The end is reported once, below: a report that finds another thread reporting is dropped.
+    if (const std::size_t d = done += range.size(); d < copies)
+      watch.report(double(d) / double(copies));
+  });
+  if (watch.cancelled()) return scene;  // not to be rendered
+  watch.report(1);
+  unplaced.clear();
+  std::vector<double> field_g;  // the different anisotropies of index-matched media
   for (std::size_t k = 0; k < desc.objects.size(); ++k) {
     const ObjectDesc& od = desc.objects[k];
-    if (failed[k]) std::rethrow_exception(failed[k]);
-    SceneObject obj;
     const int medium = compiled_medium(od);
-    obj.tape = std::move(tapes[k]);
-    const Bounds& b = obj.tape.bounds;  // compile() computed them
-    if (!b.bounded)
-      throw SceneError(fmt::format(
-          "{}: {}/shape: shape \"{}\" is unbounded; clip it with an intersection (e.g. a box)",
-          desc.source, od.json_path, od.shape_name));
-    if (b.box.empty()) continue;  // nothing is inside: the object cannot be seen
-    obj.bounds = b.box;
-    obj.surface = compile_surface(od.surface);
-    obj.medium = medium;
-    const double g = obj.medium >= 0 ? scene.media[obj.medium].g : 0;
-    if (obj.surface.type == Surface::Type::None && obj.medium >= 0 &&
-        std::find(field_g.begin(), field_g.end(), g) == field_g.end()) {
-      if (field_g.size() == size_t(kMaxPhaseLobes))
+    for (std::size_t i = first[k]; i < first[k + 1]; ++i) {
+      if (failed[i]) std::rethrow_exception(failed[i]);
+      SceneObject obj;
+      obj.tape = std::move(tapes[i]);
+      const Bounds& b = obj.tape.bounds;  // compile() computed them
+      // Transforms nested in the shape and the instance's may compose past a double's range.
+      for (const Quadric& q : obj.tape.quadrics)
+        if (!std::all_of(q.a.begin(), q.a.end(), [](double a) { return std::isfinite(a); }))
+          throw SceneError(fmt::format(
+              "{}: {}{}: the transforms placing shape \"{}\" compose beyond a double's range",
+              desc.source, od.json_path,
+              od.instances ? fmt::format("/instances (instance {})", i - first[k]) : "/shape",
+              od.shape_name));
+      if (!b.bounded)
         throw SceneError(fmt::format(
-            "{}: {}/medium: medium \"{}\" has a {}th different phase anisotropy (g {:g}) among "
-            "the index-matched (surface none) media; at most {} are supported",
-            desc.source, od.json_path, desc.media[obj.medium].name, kMaxPhaseLobes + 1, g,
-            kMaxPhaseLobes));
-      field_g.push_back(g);
+            "{}: {}/shape: shape \"{}\" is unbounded; clip it with an intersection (e.g. a box)",
+            desc.source, od.json_path, od.shape_name));
+      if (b.box.empty()) continue;  // nothing is inside: the object cannot be seen
+      obj.bounds = b.box;
+      obj.surface = compile_surface(od.surface);
+      obj.medium = medium;
+      obj.source = int(k);
+      const double g = obj.medium >= 0 ? scene.media[obj.medium].g : 0;
+      if (obj.surface.type == Surface::Type::None && obj.medium >= 0 &&
+          std::find(field_g.begin(), field_g.end(), g) == field_g.end()) {
+        if (field_g.size() == size_t(kMaxPhaseLobes))
+          throw SceneError(fmt::format(
+              "{}: {}/medium: medium \"{}\" has a {}th different phase anisotropy (g {:g}) "
+              "among the index-matched (surface none) media; at most {} are supported",
+              desc.source, od.json_path, desc.media[obj.medium].name, kMaxPhaseLobes + 1, g,
+              kMaxPhaseLobes));
+        field_g.push_back(g);
+      }
+      scene.objects.push_back(std::move(obj));
     }
-    scene.objects.push_back(std::move(obj));
-    object_descs.push_back(&od);
   }
   scene.lights = desc.lights;
   finish_scene(scene, monitor);
@@ -162,7 +210,7 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
       throw SceneError(fmt::format(
           "{}: {}/medium: medium \"{}\" may cost {:.3g} null collisions along a ray across the "
           "object; at most {:.0e} are supported ({})",
-          desc.source, object_descs[i]->json_path, desc.media[obj.medium].name, tau,
+          desc.source, desc.objects[size_t(obj.source)].json_path, desc.media[obj.medium].name, tau,
           kMaxOpticalThickness,
           scale > 1 ? fmt::format("integrator.majorant.scale {:g} multiplies the majorants", scale)
                     : "a heterogeneous or chromatic medium this dense, or a gray one past "

@@ -20,11 +20,12 @@ inline constexpr double kMaxOpticalThickness = 1e6;
 
 // Throws SceneError (one line, with the JSON path) for what only compilation can see, such as an
 // object whose shape is unbounded or a medium that may cost more than kMaxOpticalThickness null
-// collisions per ray.
-// The monitor watches the majorant octrees' build (media/octree.h), and its cancel stops the
-// objects' compile as well: a cancelled compile returns a scene that must not be rendered. Reads the
-// files the description names (VDB grids) and records them in `inputs`, in the order read: what
-// a render's fingerprint holds and its outputs must not overwrite.
+// collisions per ray. An object with instances becomes one object per instance, in their order.
+// The monitor watches the objects' compile (objects) and the majorant octrees' build (progress,
+// media/octree.h); its cancel stops both: a cancelled compile returns a scene that must not be
+// rendered. `inputs` gets the files the description read (instances files) and those compiling
+// it reads (VDB grids), in that order: what a render's fingerprint holds and its outputs must not
+// overwrite.
 Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor = {},
                     std::vector<InputFile>* inputs = nullptr);
 

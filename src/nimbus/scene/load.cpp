@@ -23,6 +23,7 @@
 #include "nimbus/scene/colour_reader.h"
 #include "nimbus/scene/density_types.h"
 #include "nimbus/scene/emission_grid.h"
+#include "nimbus/scene/instances_file.h"
 #include "nimbus/scene/light_types.h"
 
 namespace nimbus {
@@ -118,13 +119,24 @@ Mat4 read_transform(const JsonValue& v) {
     }
     m = s * m;  // steps apply in the listed order
   }
-  const double det = determinant(m);
   // Scale factors multiply along the steps: 400 steps of 10 leave a double's range.
-  if (!std::isfinite(det))
+  if (!std::isfinite(determinant(m)))
     v.fail("the steps compose to a transform beyond a double's range (their scales multiply)");
-  if (!(std::abs(det) > kMinDeterminant))
-    v.fail(fmt::format("degenerate transform (determinant {})", det));
+  if (const std::string problem = transform_problem(m); !problem.empty()) v.fail(problem);
   return m;
+}
+
+std::string transform_problem(const Mat4& m) {
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c)
+      if (!(std::abs(m(r, c)) <= kMaxCoordinate))
+        return fmt::format("entry ({}, {}) is {}; entries must be within ±{:g}", r, c, m(r, c),
+                           kMaxCoordinate);
+  const double det = determinant(m);
+  if (!std::isfinite(det)) return "a transform beyond a double's range (determinant overflows)";
+  if (!(std::abs(det) > kMinDeterminant))
+    return fmt::format("degenerate transform (determinant {})", det);
+  return "";
 }
 
 namespace {
@@ -168,6 +180,7 @@ class Loader {
     }
     if (objects)
       for (const JsonValue& o : objects->array()) scene.objects.push_back(read_object(o));
+    scene.inputs = std::move(inputs_);
     return scene;
   }
 
@@ -304,6 +317,7 @@ class Loader {
       shape_value.fail(
           fmt::format("the shape holds more than {} quadrics (each use of a named shape counts)",
                       kMaxTapeQuadrics));
+    if (auto instances = o.optional("instances")) obj.instances = read_instances(*instances);
     const auto medium = o.optional("medium");
     if (medium) {
       const auto it = media_index_.find(medium->string());
@@ -346,6 +360,40 @@ class Loader {
         obj.surface.type != SurfaceDesc::Type::Dielectric)
       medium->fail(R"(only objects with surface "none" or "dielectric" can hold a medium)");
     return obj;
+  }
+
+  // An object's "instances": an array of transforms, or {"file": "x.npy"}, a side file of them
+  // (scene/instances_file.h) relative to the scene file's folder. Each becomes a copy of the
+  // object; every transform is checked as a shape's is.
+  std::shared_ptr<const std::vector<Mat4>> read_instances(const JsonValue& v) {
+    std::vector<Mat4> transforms;
+    if (v.json().is_array()) {
+      const std::vector<JsonValue> items = v.array();
+      if (items.empty()) v.fail("must hold at least one transform");
+      if (items.size() > kMaxInstances)
+        v.fail(fmt::format("holds {} transforms; an object may have at most {}", items.size(),
+                           kMaxInstances));
+      transforms.reserve(items.size());
+      for (const JsonValue& t : items) transforms.push_back(read_transform(t));
+    } else if (v.json().is_object()) {
+      JsonObject o(v);
+      const JsonValue file = o.required("file");
+      o.finish(R"(for instances from a file)");
+      if (file.string().empty()) file.fail("must name a file");
+      const std::string path = (std::filesystem::path(v.origin().folder) / file.string()).string();
+      try {
+        transforms = read_instances_file(path);
+      } catch (const InstancesFileError& e) {
+        file.fail(fmt::format("{}: {}", file.string(), e.what()));
+      }
+      for (std::size_t k = 0; k < transforms.size(); ++k)
+        if (const std::string problem = transform_problem(transforms[k]); !problem.empty())
+          file.fail(fmt::format("{}: instance {}: {}", file.string(), k, problem));
+      inputs_.push_back(record_input_file(file.pointer(), path));
+    } else {
+      v.fail(R"(expected an array of transforms or {"file": "NAME.npy"})");
+    }
+    return std::make_shared<const std::vector<Mat4>>(std::move(transforms));
   }
 
   // A shape where one is expected: the name of a shape in "shapes", or an inline shape object.
@@ -492,6 +540,7 @@ class Loader {
   int shape_depth_ = 0;           // shapes being read, one inside the other
   std::vector<Visit> resolving_;  // named shapes being built, outermost first
   std::map<std::string, int> media_index_;
+  std::vector<InputFile> inputs_;  // the instances files read
 };
 
 // The scene file's text: a regular file of at most kMaxSceneFileBytes, in UTF-8. Anything else

@@ -68,6 +68,10 @@ SceneDesc load_scene_json(nlohmann::json j, const std::string& source,
 // fails. Shapes and the "vdb" density read it.
 Mat4 read_transform(const JsonValue& v);
 
+// What is wrong with a transform placing a shape, or "": an entry beyond ±kMaxCoordinate (or not
+// finite), or a determinant that overflows or is degenerate (|det| <= 1e-12).
+std::string transform_problem(const Mat4& m);
+
 // Applies one `--set KEY=VALUE`: KEY is a dotted path into the document (array elements by
 // index, as in lights.0.radiance), VALUE is parsed as JSON or else taken as a string. Missing
 // object keys along the path are created; a path through a value that is neither an object nor

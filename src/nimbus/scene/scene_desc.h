@@ -1,8 +1,9 @@
 #pragma once
 // The scene as the scene file states it, validated (scene/load.h) and nothing more: plain
-// structs with the file's defaults. Loading reads no file but the scene file: what a grid file
-// holds is read by compile_scene (scene/input_file.h), which builds the run-time Scene and trusts
-// these values; docs/scene-format.md documents every field.
+// structs with the file's defaults. Loading reads the scene file and the instances files its
+// objects name (their transforms are what the description says); what a grid file holds is read
+// by compile_scene (scene/input_file.h), which builds the run-time Scene and trusts these values;
+// docs/scene-format.md documents every field.
 
 #include <cstdint>
 #include <memory>
@@ -67,6 +68,11 @@ struct ObjectDesc {
   std::string json_path;   // e.g. "/objects/1", for messages from later stages
   SurfaceDesc surface;
   int medium = -1;  // index into SceneDesc::media, or -1
+  // The "instances" key: copies of the object, each with its shape placed by one transform
+  // (after the shape's own); null: the object once, as its shape stands.
+  std::shared_ptr<const std::vector<Mat4>> instances;
+  // The objects this one stands for.
+  std::size_t copies() const { return instances ? instances->size() : 1; }
 };
 
 struct SceneDesc {
@@ -78,6 +84,8 @@ struct SceneDesc {
   std::vector<Light> lights;
   std::vector<MediumDesc> media;
   std::vector<ObjectDesc> objects;
+  // The files read while loading (instances files), for the render's fingerprint.
+  std::vector<InputFile> inputs;
   // The document as loaded, after the overrides (null for a description built in code): with the
   // files that compiling it reads, what the render is of (job/fingerprint.h), without a second
   // parse.
