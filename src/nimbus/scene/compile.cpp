@@ -158,6 +158,7 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
   watch.report(1);
   unplaced.clear();
   std::vector<double> field_g;  // the different anisotropies of index-matched media
+  scene.objects.reserve(copies);  // growing it would hold two copies of 10^6 objects at once
   for (std::size_t k = 0; k < desc.objects.size(); ++k) {
     const ObjectDesc& od = desc.objects[k];
     const int medium = compiled_medium(od);
@@ -197,6 +198,9 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
       scene.objects.push_back(std::move(obj));
     }
   }
+  // Their moved-from husks (264 bytes a copy) would stay through the octrees' build.
+  std::vector<Tape>().swap(tapes);
+  std::vector<std::exception_ptr>().swap(failed);
   scene.lights = desc.lights;
   finish_scene(scene, monitor);
   for (size_t i = 0; i < scene.objects.size(); ++i) {
