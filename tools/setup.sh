@@ -12,6 +12,8 @@ packages=(
   colord-data python3-numpy python3-matplotlib
   # MPI: `mpirun -np K nimbus render` (README, "Rendering on a cluster")
   libopenmpi-dev openmpi-bin
+  # Embree 3: bench/embree_bvh, its kernels against our surface hierarchy (docs/benchmarks.md)
+  libembree-dev
 )
 missing=()
 for p in "${packages[@]}"; do
