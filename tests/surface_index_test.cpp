@@ -72,9 +72,14 @@ Light sphere_light(const Vec3& center, double radius) {
 // n objects in a cube of half-size `spread`: spheres, bumpy free forms (the flat path) and
 // CSG (the general one), some media holders without a surface, a few sphere lights, and
 // deliberate ties: an object given twice, a light on an object's very sphere.
-Scene scattered_scene(int n, double spread, uint64_t seed) {
+Scene scattered_scene(int n, double spread, uint64_t seed, double scale = 1, Vec3 shift = {}) {
   Rng rng(seed, 3);
   Scene scene;
+  const Mat4 place = Mat4::translate(shift) * Mat4::scale({scale, scale, scale});
+  const auto placed = [&](const ShapePtr& shape) { return with_transform(shape, place); };
+  const auto placed_light = [&](const Vec3& c, double r) {
+    return sphere_light(transform_point(place, c), r * scale);
+  };
   for (int i = 0; i < n; ++i) {
     const Vec3 c = random_in_cube(rng, spread);
     const double r = 0.05 + 0.4 * rng.uniform();
@@ -96,15 +101,17 @@ Scene scattered_scene(int n, double spread, uint64_t seed) {
     const Surface::Type surface = i % 9 == 5   ? Surface::Type::None
                                   : i % 5 == 1 ? Surface::Type::Dielectric
                                                : Surface::Type::Diffuse;
-    scene.objects.push_back(test::object_of(shape, surface, -1));
+    scene.objects.push_back(test::object_of(placed(shape), surface, -1));
     if (i % 13 == 0) scene.objects.push_back(scene.objects.back());  // a tie: the first wins
   }
-  for (int i = 0; i < 1 + n / 50; ++i)
-    scene.lights.push_back(sphere_light(random_in_cube(rng, spread), 0.1 + 0.3 * rng.uniform()));
+  for (int i = 0; i < 1 + n / 50; ++i) {
+    const Vec3 c = random_in_cube(rng, spread);
+    scene.lights.push_back(placed_light(c, 0.1 + 0.3 * rng.uniform()));
+  }
   scene.lights.push_back(test::environment(1));
-  scene.lights.push_back(sphere_light({0, 0, 0}, 0.3));  // on the object below: it wins the tie
+  scene.lights.push_back(placed_light({0, 0, 0}, 0.3));  // on the object below: it wins the tie
   scene.objects.push_back(
-      test::object_of(test::leaf(sphere({0, 0, 0}, 0.3)), Surface::Type::Diffuse, -1));
+      test::object_of(placed(test::leaf(sphere({0, 0, 0}, 0.3))), Surface::Type::Diffuse, -1));
   scene.surfaces = build_surface_index(scene.objects, scene.lights);
   return scene;
 }
@@ -114,17 +121,20 @@ int depth_of(const SurfaceIndex& index, std::uint32_t at = 0) {
   return node.count > 0 ? 0 : 1 + std::max(depth_of(index, at + 1), depth_of(index, node.index));
 }
 
-void expect_as_the_list(const Scene& scene, uint64_t seed, double spread) {
+// Rays through the scene of scattered_scene (placed alike) against the walk down the list.
+void expect_as_the_list(const Scene& scene, uint64_t seed, double spread, double scale = 1,
+                        Vec3 shift = {}) {
   Rng rng(seed, 11);
   int hits = 0;
   for (int i = 0; i < 3000; ++i) {
-    // From outside and from inside the cloud of objects; some directions along the axes, whose
-    // zero components the box tests must survive.
-    const Vec3 o = random_in_cube(rng, i % 2 ? 2 * spread : 0.5 * spread);
+    // From outside and from inside the cloud of objects, some from 10^4 times farther; some
+    // directions along the axes, whose zero components the box tests must survive.
+    Vec3 o = random_in_cube(rng, i % 2 ? 2 * spread : 0.5 * spread);
+    if (i % 11 == 0) o = o * 1e4;
     Vec3 d = i % 7 == 0 ? Vec3{0, 0, rng.uniform() < 0.5 ? 1.0 : -1.0} : random_unit(rng);
     if (i % 3 == 0) d = normalize(random_in_cube(rng, 0.3 * spread) - o);
-    const Ray ray{o, d};
-    const double t_max = i % 5 == 0 ? spread * rng.uniform() : Box::kInf;
+    const Ray ray{o * scale + shift, d};
+    const double t_max = i % 5 == 0 ? spread * scale * rng.uniform() : Box::kInf;
     const auto expected = intersect_by_list(scene, ray, t_max);
     const auto got = intersect(scene, ray, t_max);
     ASSERT_EQ(got.has_value(), expected.has_value()) << "ray " << i;
@@ -146,6 +156,20 @@ TEST(SurfaceIndex, NearestHitsAreTheListsBitForBit) {
     const double spread = 0.5 * std::cbrt(double(n)) + 0.5;
     const Scene scene = scattered_scene(n, spread, uint64_t(n));
     expect_as_the_list(scene, uint64_t(n) + 100, spread);
+  }
+}
+
+// Scenes far past a float's range or far below its resolution, and far from the origin, hit as
+// the list does (the hierarchy's boxes and slabs are doubles).
+TEST(SurfaceIndex, ScenesOfAnyScaleAndPlaceHitAsTheList) {
+  const double spread = 0.5 * std::cbrt(200.0) + 0.5;
+  for (const auto& [scale, shift] :
+       {std::pair{1e45, Vec3{3e46, -1e46, 0}}, std::pair{1e-35, Vec3{0, 0, 0}},
+        std::pair{1e-3, Vec3{1e4, 2e4, -3e4}}}) {
+    SCOPED_TRACE(scale);
+    const Scene scene = scattered_scene(200, spread, 17, scale, shift);
+    ASSERT_GT(scene.surfaces.nodes.size(), 1u);
+    expect_as_the_list(scene, 23, spread, scale, shift);
   }
 }
 
