@@ -21,8 +21,8 @@ struct MemoryEstimate {
 };
 
 // What `copies` compiled objects whose shapes hold `quadrics` quadrics each take: their tapes,
-// bounds, surfaces and the surface index over them (measured at 10^6 copies: about 1.6 KB a
-// sphere, 2.7 KB a free form of five quadrics).
+// bounds, surfaces and the surface index over them (measured at 10^6 copies: about 1.3 KB a
+// sphere, 2.5 KB a free form of five quadrics; charged a little more).
 double object_memory(std::size_t copies, std::size_t quadrics);
 
 // For an image of width × height, `octrees` majorant octrees (the field's and one per solid
