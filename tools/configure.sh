@@ -13,7 +13,8 @@ kind=${1:?"usage: tools/configure.sh release|sanitize [DIR] [CMAKE ARGS...]"}
 case $kind in
   release)
     dir=${2:-build}
-    args=(-DCMAKE_BUILD_TYPE=Release)
+    # Debian's interpreter, which has python3-numpy, for the Python module (docs/python.md).
+    args=(-DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=/usr/bin/python3)
     ;;
   sanitize)
     dir=${2:-build-sanitize}

@@ -10,6 +10,8 @@ packages=(
   # vdb_print, which the tests run on exported files
   libopenvdb-dev libnanovdb-dev libboost-iostreams-dev libopenvdb-tools
   colord-data python3-numpy python3-matplotlib
+  # The Python module (python/, docs/python.md) and its tests
+  python3-dev pybind11-dev python3-pytest
   # MPI: `mpirun -np K nimbus render` (README, "Rendering on a cluster")
   libopenmpi-dev openmpi-bin
   # Embree 3: bench/embree_bvh, its kernels against our surface hierarchy (docs/benchmarks.md)

@@ -45,13 +45,26 @@ int RenderJob::read_resume() {
 }
 
 void RenderJob::load(const std::string& scene_file, int spp) {
+  use_description(load_scene_file(scene_file, overrides()), spp);
+  scene_file_ = scene_file;
+}
+
+void RenderJob::load_document(const nlohmann::json& document, const std::string& source, int spp) {
+  use_description(load_scene_json(document, source, overrides()), spp);
+  scene_file_.clear();
+}
+
+std::vector<std::string> RenderJob::overrides() const {
   // The seed is part of what the render is of (the document, hence the fingerprint); spp only
   // says how many samples to take, and goes to the settings as it is.
   std::vector<std::string> overrides = options_.overrides;
   if (options_.seed) overrides.push_back(fmt::format("integrator.seed={}", *options_.seed));
-  desc_ = load_scene_file(scene_file, overrides);
+  return overrides;
+}
+
+void RenderJob::use_description(SceneDesc desc, int spp) {
+  desc_ = std::move(desc);
   if (spp > 0) desc_.settings.spp = spp;
-  scene_file_ = scene_file;
   compiled_ = false;
 }
 

@@ -82,6 +82,9 @@ class RenderJob {
   int read_resume();
   // Loads the scene file with the overrides, `spp` (if > 0) and the seed. SceneError.
   void load(const std::string& scene_file, int spp);
+  // As load, for a scene document in memory (a program's, or Python's nimbus.load_dict):
+  // `source` names it in messages; relative file names resolve against the current directory.
+  void load_document(const nlohmann::json& document, const std::string& source, int spp);
   // The lead's: the memory suffices, and the checkpoint to continue is of this scene's document
   // and settings, with its film size and no pixel past its spp. JobError.
   void check() const;
@@ -119,6 +122,11 @@ class RenderJob {
 
   RenderJobOptions options_;
   std::string checkpoint_file_;
+  // The options' overrides and seed, as --set overrides of the document.
+  std::vector<std::string> overrides() const;
+  // desc as the job's description, to render at spp (> 0; else its own).
+  void use_description(SceneDesc desc, int spp);
+
   std::string scene_file_;
   std::optional<Checkpoint> resumed_;
   SceneDesc desc_;

@@ -1,0 +1,156 @@
+"""The Python module against the command line (issue 27): the same pixels, the same errors,
+bad arguments refused, the GIL released while rendering, Ctrl-C ending a render.
+
+Run by ctest (test Python) with PYTHONPATH on the build's python/ folder, NIMBUS_EXE the nimbus
+executable and NIMBUS_SOURCE_DIR the checkout."""
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import nimbus
+
+SOURCE = os.environ.get("NIMBUS_SOURCE_DIR",
+                        os.path.join(os.path.dirname(__file__), "..", ".."))
+EXE = os.environ.get("NIMBUS_EXE", os.path.join(SOURCE, "build", "nimbus"))
+DEMO = os.path.join(SOURCE, "scenes", "demo.json")
+SMALL = {"film.width": 24, "film.height": 16}
+
+
+def cli_render(tmp_path, scene, *args):
+    out = tmp_path / "cli.exr"
+    subprocess.run([EXE, "render", str(scene), "-o", str(out), "-q", *args], check=True)
+    return nimbus.read_exr(out)
+
+
+def test_the_pixels_are_the_command_lines_to_the_bit(tmp_path):
+    reference = cli_render(tmp_path, DEMO, "--spp", "4", "--seed", "7",
+                           "--set", "film.width=24", "--set", "film.height=16")
+    image = nimbus.render(nimbus.load_file(DEMO, SMALL), spp=4, seed=7)
+    assert image.dtype == np.float32
+    assert image.shape == (16, 24, 3)
+    assert np.array_equal(image, reference)
+    assert image.mean() > 0
+
+
+def test_a_dict_renders_as_its_file(tmp_path):
+    with open(DEMO) as f:
+        document = json.load(f)
+    document["film"] = {**document.get("film", {}), "width": 24, "height": 16}
+    image = nimbus.render(nimbus.load_dict(document), spp=2)
+    assert np.array_equal(image, nimbus.render(nimbus.load_file(DEMO, SMALL), spp=2))
+
+
+def test_the_thread_count_changes_no_pixel():
+    scene = nimbus.load_file(DEMO, SMALL)
+    assert np.array_equal(nimbus.render(scene, spp=3, threads=1),
+                          nimbus.render(scene, spp=3, threads=2))
+
+
+def test_errors_are_the_command_lines_line(tmp_path):
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"camera": {"from": [0, 0, 5], "to": [0, 0, 0]}, '
+                   '"objects": [{"shape": "blobb"}]}')
+    cli = subprocess.run([EXE, "render", str(bad), "-o", str(tmp_path / "x.exr")],
+                         capture_output=True, text=True)
+    assert cli.returncode == 2
+    with pytest.raises(nimbus.SceneError) as e:
+        nimbus.load_file(bad)
+    assert str(e.value) == cli.stderr.strip()
+    assert "/objects/0/shape" in str(e.value)
+    assert isinstance(e.value, ValueError)
+    with pytest.raises(nimbus.SceneError, match=r'^<dict>: /objects/0/shape: unknown shape "blobb"'):
+        nimbus.load_dict(json.loads(bad.read_text()))
+    with pytest.raises(nimbus.SceneError, match=r"/integrator/spp: expected an integer"):
+        nimbus.load_file(DEMO, {"integrator.spp": "many"})
+    with pytest.raises(nimbus.SceneError, match="cannot open file"):
+        nimbus.load_file(tmp_path / "missing.json")
+    with pytest.raises(nimbus.SceneError, match="not a JSON document"):
+        nimbus.load_dict({"camera": float("nan")})
+
+
+def test_bad_arguments_raise_value_or_type_errors():
+    scene = nimbus.load_file(DEMO, SMALL)
+    for spp in (0, -1):
+        with pytest.raises(ValueError, match="spp must be"):
+            nimbus.render(scene, spp=spp)
+    for spp in (1.5, "4", True):
+        with pytest.raises(TypeError, match="spp must be an integer"):
+            nimbus.render(scene, spp=spp)
+    with pytest.raises(ValueError, match="threads must be"):
+        nimbus.render(scene, spp=1, threads=0)
+    with pytest.raises(ValueError, match="seed must be"):
+        nimbus.render(scene, spp=1, seed=-3)
+    with pytest.raises(TypeError, match="nimbus.Scene"):
+        nimbus.render(DEMO)
+    with pytest.raises(TypeError, match="overrides must be a dict"):
+        nimbus.load_file(DEMO, ["film.width=3"])
+    with pytest.raises(TypeError, match="progress must be"):
+        nimbus.render(scene, spp=1, progress="yes")
+    with pytest.raises(TypeError, match="a scene document is a dict"):
+        nimbus.load_dict("scene.json")
+
+
+def test_stats_and_progress():
+    scene = nimbus.load_file(DEMO, SMALL)
+    seen = []
+    image, stats = nimbus.render(scene, spp=2, stats=True, progress=lambda d, t: seen.append((d, t)))
+    assert image.shape == (16, 24, 3)
+    assert stats["samples_per_second"] > 0
+    assert seen and seen[-1] == (24 * 16 * 2, 24 * 16 * 2)
+    assert all(a[0] <= b[0] for a, b in zip(seen, seen[1:]))
+    assert nimbus.__version__
+
+
+def test_other_threads_run_while_rendering():
+    scene = nimbus.load_file(DEMO, {"film.width": 96, "film.height": 64})
+    ticks = []
+    stop = threading.Event()
+
+    def tick():
+        while not stop.is_set():
+            ticks.append(time.monotonic())
+            time.sleep(0.005)
+
+    t = threading.Thread(target=tick)
+    t.start()
+    start = time.monotonic()
+    nimbus.render(scene, spp=64, threads=1)
+    end = time.monotonic()
+    stop.set()
+    t.join()
+    during = [x for x in ticks if start < x < end]
+    # The render holds the GIL only between its 50 ms polls: the ticker runs throughout.
+    assert end - start > 0.2
+    assert len(during) > 0.5 * (end - start) / 0.005 * 0.2
+
+
+def test_ctrl_c_ends_a_render_with_keyboard_interrupt():
+    script = ("import sys, nimbus\n"
+              f"s = nimbus.load_file({DEMO!r}, {{'film.width': 256, 'film.height': 256}})\n"
+              "print('ready', flush=True)\n"
+              "nimbus.render(s, spp=100000)\n")
+    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, env=os.environ.copy())
+    assert child.stdout.readline().strip() == "ready"
+    time.sleep(0.5)
+    sent = time.monotonic()
+    child.send_signal(signal.SIGINT)
+    _, err = child.communicate(timeout=30)
+    assert time.monotonic() - sent < 1.5
+    assert child.returncode != 0
+    assert "KeyboardInterrupt" in err
+
+
+def test_the_example_script_makes_its_figure(tmp_path):
+    out = tmp_path / "figure.png"
+    run = subprocess.run([sys.executable, os.path.join(SOURCE, "examples", "python", "spp_figure.py"),
+                          str(out)], capture_output=True, text=True, env=os.environ.copy())
+    assert run.returncode == 0, run.stderr
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
