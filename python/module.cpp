@@ -6,11 +6,15 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <exception>
+#include <functional>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -18,8 +22,12 @@
 #include <vector>
 
 #include "nimbus/io/exr.h"
+#include "nimbus/io/film_file.h"
 #include "nimbus/io/film_image.h"
+#include "nimbus/io/output.h"
 #include "nimbus/job/render_job.h"
+#include "nimbus/render/renderer.h"
+#include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
 
 namespace py = pybind11;
@@ -37,7 +45,18 @@ struct PyScene {
   std::vector<std::string> overrides;
   int width = 0, height = 0, spp = 0;
   uint64_t seed = 0;
+  // The scene compiled for a seed, for films and render_into: the last one asked for.
+  std::shared_ptr<std::pair<std::optional<uint64_t>, std::shared_ptr<const Scene>>> compiled =
+      std::make_shared<std::pair<std::optional<uint64_t>, std::shared_ptr<const Scene>>>();
 };
+
+// The description as a render loads it: the overrides, then the seed if one is given.
+SceneDesc reload(const PyScene& scene, std::optional<uint64_t> seed) {
+  std::vector<std::string> overrides = scene.overrides;
+  if (seed) overrides.push_back("integrator.seed=" + std::to_string(*seed));
+  return scene.path.empty() ? load_scene_json(scene.document, scene.source, overrides)
+                            : load_scene_file(scene.path, overrides);
+}
 
 PyScene describe(const SceneDesc& desc, PyScene s) {
   s.width = desc.settings.width;
@@ -75,36 +94,21 @@ bool prepare(RenderJob& job, const PyScene& scene, const BuildMonitor& monitor) 
   return true;
 }
 
-// Renders on a worker thread while this one, holding the GIL only between waits, polls Python's
-// signals (a Ctrl-C raises KeyboardInterrupt here and cancels the job) and calls `progress` with
-// the fraction done. Returns the image and the --stats JSON text.
-py::tuple render(const PyScene& scene, int spp, std::optional<uint64_t> seed, int threads,
-                 const py::object& progress) {
-  RenderJobOptions options;
-  options.overrides = scene.overrides;
-  options.spp = spp;
-  options.seed = seed;
-  options.threads = threads;
-  std::atomic<bool> stop{false};
-  std::atomic<double> fraction{0};
-  options.cancel = [&stop] { return stop.load(std::memory_order_relaxed); };
-  options.progress = [&fraction](double f) { fraction.store(f, std::memory_order_relaxed); };
-  RenderJob job(options);
-  JobOutcome outcome;
-  bool compiled = false;
-  std::exception_ptr failure;
+// Runs work(stop) on a worker thread while this one, holding the GIL only between waits, polls
+// Python's signals (a Ctrl-C raises KeyboardInterrupt here and sets `stop`) and calls `progress`
+// with the fraction that work stores. Rethrows what work or progress threw.
+void run_interruptible(const std::function<void(const std::atomic<bool>& stop)>& work,
+                       const std::atomic<double>& fraction, std::atomic<bool>& stop,
+                       const py::object& progress) {
+  std::exception_ptr failure, callback_failure;
   std::mutex mutex;
   std::condition_variable finished;
-  bool done = false;
-  bool interrupted = false;
-  std::exception_ptr callback_failure;
+  bool done = false, interrupted = false;
   {
     py::gil_scoped_release release;
     std::thread worker([&] {
       try {
-        const BuildMonitor monitor{nullptr, options.cancel, nullptr};
-        compiled = prepare(job, scene, monitor);
-        if (compiled && !stop) outcome = job.run();
+        work(stop);
       } catch (...) {
         failure = std::current_exception();
       }
@@ -141,9 +145,89 @@ py::tuple render(const PyScene& scene, int spp, std::optional<uint64_t> seed, in
   if (interrupted) throw py::error_already_set();
   if (callback_failure) std::rethrow_exception(callback_failure);
   if (failure) std::rethrow_exception(failure);
-  if (!compiled || outcome.stopped) throw std::runtime_error("the render was stopped");
   if (!progress.is_none()) progress(1.0);
+}
+
+// A render job as `nimbus render` runs it. Returns the image and the --stats JSON text.
+py::tuple render(const PyScene& scene, int spp, std::optional<uint64_t> seed, int threads,
+                 const py::object& progress) {
+  RenderJobOptions options;
+  options.overrides = scene.overrides;
+  options.spp = spp;
+  options.seed = seed;
+  options.threads = threads;
+  std::atomic<bool> stop{false};
+  std::atomic<double> fraction{0};
+  options.cancel = [&stop] { return stop.load(std::memory_order_relaxed); };
+  options.progress = [&fraction](double f) { fraction.store(f, std::memory_order_relaxed); };
+  RenderJob job(options);
+  JobOutcome outcome;
+  bool compiled = false;
+  run_interruptible(
+      [&](const std::atomic<bool>& stopped) {
+        compiled = prepare(job, scene, BuildMonitor{nullptr, options.cancel, nullptr});
+        if (compiled && !stopped) outcome = job.run();
+      },
+      fraction, stop, progress);
+  if (!compiled || outcome.stopped) throw std::runtime_error("the render was stopped");
   return py::make_tuple(to_array(to_image(outcome.film)), job.stats(outcome).dump());
+}
+
+// The scene compiled for `seed` (its own when none), compiled once for the last seed asked.
+std::shared_ptr<const Scene> compiled_scene(const PyScene& scene, std::optional<uint64_t> seed) {
+  auto& cache = *scene.compiled;
+  if (!cache.second || cache.first != seed) {
+    SceneDesc desc = reload(scene, seed);
+    py::gil_scoped_release release;
+    cache.second = std::make_shared<const Scene>(compile_scene(desc));
+    cache.first = seed;
+  }
+  return cache.second;
+}
+
+// A film of the scene's size and light scale (its exponent), for render_into.
+Film film_of(const PyScene& scene) {
+  const auto compiled = compiled_scene(scene, std::nullopt);
+  return Film(compiled->settings.width, compiled->settings.height, compiled->film_exponent);
+}
+
+// Samples [s0, s1) of every pixel into the film; a stopped render leaves the film as it was.
+void render_into_film(const PyScene& scene, Film& film, int s0, int s1,
+                      std::optional<uint64_t> seed, int threads, const py::object& progress) {
+  const auto compiled = compiled_scene(scene, seed);
+  if (film.width != compiled->settings.width || film.height != compiled->settings.height)
+    throw py::value_error("the film is " + std::to_string(film.width) + "x" +
+                          std::to_string(film.height) + ", the scene's image " +
+                          std::to_string(compiled->settings.width) + "x" +
+                          std::to_string(compiled->settings.height));
+  if (film.exponent != compiled->film_exponent)
+    throw py::value_error("the film sums another scene's light (its exponent " +
+                          std::to_string(film.exponent) + ", the scene's " +
+                          std::to_string(compiled->film_exponent) + ")");
+  Film into = film;  // the film changes only once every pixel has the range's samples
+  std::atomic<bool> stop{false};
+  std::atomic<double> fraction{0};
+  RenderOptions options;
+  options.threads = threads;
+  options.range.s0 = s0;
+  options.range.s1 = s1;
+  options.cancel = [&stop] { return stop.load(std::memory_order_relaxed); };
+  options.progress = [&fraction](double f) { fraction.store(f, std::memory_order_relaxed); };
+  run_interruptible([&](const std::atomic<bool>&) { render_into(*compiled, into, options); },
+                    fraction, stop, progress);
+  film = std::move(into);
+}
+
+// Per pixel, per channel, of a film: values(pixel) as a float32 (height, width, 3) array.
+template <class Values>
+py::array_t<float> film_array(const Film& film, Values&& values) {
+  py::array_t<float> a({film.height, film.width, 3});
+  float* out = a.mutable_data();
+  for (int p = 0; p < film.pixels(); ++p) {
+    const Rgb v = values(p);
+    for (int c = 0; c < 3; ++c) out[3 * p + c] = float(v[c]);
+  }
+  return a;
 }
 
 }  // namespace nimbus_python
@@ -169,6 +253,49 @@ PYBIND11_MODULE(_core, m) {
   m.def("load_text", &np::load_text, py::arg("text"), py::arg("source"));
   m.def("render", &np::render, py::arg("scene"), py::arg("spp"), py::arg("seed"),
         py::arg("threads"), py::arg("progress"));
+  py::class_<nimbus::Film>(m, "Film",
+                           "Per-pixel sums of a render, which render_into continues exactly.")
+      .def(py::init(&np::film_of), py::arg("scene"))
+      .def_readonly("width", &nimbus::Film::width)
+      .def_readonly("height", &nimbus::Film::height)
+      .def_property_readonly(
+          "spp",
+          [](const nimbus::Film& f) {
+            return f.samples.empty() ? 0u : *std::min_element(f.samples.begin(), f.samples.end());
+          })
+      .def("image", [](const nimbus::Film& f) { return np::to_array(nimbus::to_image(f)); })
+      .def("variance",
+           [](const nimbus::Film& f) {
+             return np::film_array(f, [&](int p) { return f.variance_of_mean(p); });
+           })
+      .def(
+          "save",
+          [](const nimbus::Film& f, const std::filesystem::path& path) {
+            py::gil_scoped_release release;
+            nimbus::save_film(f, path.string());
+          },
+          py::arg("path"))
+      .def_static(
+          "load",
+          [](const std::filesystem::path& path) {
+            py::gil_scoped_release release;
+            return nimbus::load_film(path.string());
+          },
+          py::arg("path"))
+      .def("__repr__", [](const nimbus::Film& f) {
+        return "<nimbus.Film " + std::to_string(f.width) + "x" + std::to_string(f.height) + ">";
+      });
+  m.def("render_into", &np::render_into_film, py::arg("scene"), py::arg("film"), py::arg("s0"),
+        py::arg("s1"), py::arg("seed"), py::arg("threads"), py::arg("progress"));
+  m.def(
+      "write_image",
+      [](const std::string& path, py::array_t<float, py::array::c_style> a) {
+        nimbus::Image image{int(a.shape(1)), int(a.shape(0)), {}};
+        image.rgb.assign(a.data(), a.data() + a.size());
+        py::gil_scoped_release release;
+        nimbus::write_image(path, image);
+      },
+      py::arg("path"), py::arg("array"));
   m.def(
       "read_exr",
       [](const std::string& path) {

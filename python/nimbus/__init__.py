@@ -13,10 +13,10 @@ import sys as _sys
 import time as _time
 
 from . import _core
-from ._core import JobError, Scene, SceneError, __version__
+from ._core import Film, JobError, Scene, SceneError, __version__
 
-__all__ = ["Scene", "SceneError", "JobError", "load_file", "load_dict", "render", "read_exr",
-           "__version__"]
+__all__ = ["Scene", "SceneError", "JobError", "Film", "load_file", "load_dict", "render",
+           "render_into", "write_image", "read_exr", "__version__"]
 
 
 def _overrides(overrides):
@@ -94,17 +94,56 @@ def render(scene, spp=None, seed=None, threads=None, progress=False, stats=False
     spp = _count("spp", spp, 1, 2**31 - 1)
     seed = _count("seed", seed, 0, 2**64 - 1)
     threads = _count("threads", threads, 1, 4096)
-    if progress is True:
-        callback = _bar
-    elif progress is False or progress is None:
-        callback = None
-    elif callable(progress):
-        total = scene.width * scene.height * (spp or scene.spp)
-        callback = lambda f: progress(round(f * total), total)  # noqa: E731
-    else:
-        raise TypeError("progress must be False, True or a callable (done, total)")
+    callback = _progress(progress, scene.width * scene.height * (spp or scene.spp))
     image, stats_json = _core.render(scene, spp or 0, seed, threads or 0, callback)
     return (image, _json.loads(stats_json)) if stats else image
+
+
+def _progress(progress, total):
+    """The C++ side's callback (the fraction done) for render's or render_into's progress."""
+    if progress is True:
+        return _bar
+    if progress is False or progress is None:
+        return None
+    if callable(progress):
+        return lambda f: progress(round(f * total), total)
+    raise TypeError("progress must be False, True or a callable (done, total)")
+
+
+def render_into(scene, film, samples, seed=None, threads=None, progress=False):
+    """Adds the samples [s0, s1) of every pixel to `film` (nimbus.Film(scene)).
+
+    Consecutive ranges, (0, 8) then (8, 16), give the bits of one render of 16 samples with
+    the same seed. A stopped render (Ctrl-C: KeyboardInterrupt) leaves the film as it was.
+    """
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene must be a nimbus.Scene, not {type(scene).__name__}")
+    if not isinstance(film, Film):
+        raise TypeError(f"film must be a nimbus.Film, not {type(film).__name__}")
+    try:
+        s0, s1 = samples
+    except (TypeError, ValueError):
+        raise TypeError("samples must be a pair (s0, s1) of sample indices") from None
+    s0 = _count("samples[0]", s0, 0, 2**31 - 2)
+    s1 = _count("samples[1]", s1, 1, 2**31 - 1)
+    if s1 <= s0:
+        raise ValueError(f"samples must be a range s0 < s1, not ({s0}, {s1})")
+    seed = _count("seed", seed, 0, 2**64 - 1)
+    threads = _count("threads", threads, 1, 4096)
+    callback = _progress(progress, film.width * film.height * (s1 - s0))
+    _core.render_into(scene, film, s0, s1, seed, threads or 0, callback)
+
+
+def write_image(path, array):
+    """Writes a (height, width, 3) array of linear sRGB as EXR (float) or PNG (sRGB, 8 bits),
+    by the file's extension, atomically (a temporary file, then a rename), as nimbus render."""
+    import numpy as np
+    a = np.asarray(array)
+    if a.dtype.kind not in "fiu":
+        raise TypeError(f"an image is an array of numbers, not of {a.dtype}")
+    if a.ndim != 3 or a.shape[2] != 3 or a.shape[0] < 1 or a.shape[1] < 1:
+        raise ValueError(f"an image is an array of shape (height, width, 3), not {a.shape}")
+    _core.write_image(_os.fspath(path), np.ascontiguousarray(a, dtype=np.float32))
 
 
 def read_exr(path):

@@ -154,3 +154,71 @@ def test_the_example_script_makes_its_figure(tmp_path):
                           str(out)], capture_output=True, text=True, env=os.environ.copy())
     assert run.returncode == 0, run.stderr
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_two_sample_ranges_give_one_renders_bits(tmp_path):
+    scene = nimbus.load_file(DEMO, SMALL)
+    film = nimbus.Film(scene)
+    assert (film.width, film.height, film.spp) == (24, 16, 0)
+    nimbus.render_into(scene, film, samples=(0, 3), seed=5)
+    assert film.spp == 3
+    nimbus.render_into(scene, film, samples=(3, 6), seed=5, threads=1)
+    assert film.spp == 6
+    whole = nimbus.render(scene, spp=6, seed=5)
+    assert np.array_equal(film.image(), whole)
+    variance = film.variance()
+    assert variance.shape == (16, 24, 3) and variance.dtype == np.float32
+    assert (variance >= 0).all() and variance.max() > 0
+    film.save(tmp_path / "demo.film")
+    again = nimbus.Film.load(tmp_path / "demo.film")
+    assert np.array_equal(again.image(), whole) and again.spp == 6
+
+
+def test_films_and_ranges_are_checked():
+    scene = nimbus.load_file(DEMO, SMALL)
+    other = nimbus.load_file(DEMO, {"film.width": 8, "film.height": 8})
+    film = nimbus.Film(other)
+    with pytest.raises(ValueError, match="the film is 8x8, the scene's image 24x16"):
+        nimbus.render_into(scene, film, samples=(0, 1))
+    for samples in [(3, 3), (4, 2)]:
+        with pytest.raises(ValueError, match="s0 < s1"):
+            nimbus.render_into(other, film, samples=samples)
+    with pytest.raises(ValueError, match="samples\\[0\\] must be"):
+        nimbus.render_into(other, film, samples=(-1, 2))
+    for samples in ["ab", 3, (1.0, 2)]:
+        with pytest.raises(TypeError):
+            nimbus.render_into(other, film, samples=samples)
+    with pytest.raises(TypeError, match="film must be a nimbus.Film"):
+        nimbus.render_into(other, np.zeros((8, 8, 3)), samples=(0, 1))
+    assert film.spp == 0  # nothing was rendered into it
+
+
+def test_write_image_writes_exr_and_png_atomically(tmp_path):
+    image = nimbus.render(nimbus.load_file(DEMO, SMALL), spp=2)
+    nimbus.write_image(tmp_path / "a.exr", image)
+    assert np.array_equal(nimbus.read_exr(tmp_path / "a.exr"), image)
+    nimbus.write_image(tmp_path / "a.png", image.astype(np.float64))
+    assert (tmp_path / "a.png").read_bytes()[:4] == b"\x89PNG"
+    with pytest.raises(ValueError, match="shape \\(height, width, 3\\)"):
+        nimbus.write_image(tmp_path / "b.exr", np.zeros((4, 4)))
+    with pytest.raises(TypeError, match="array of numbers"):
+        nimbus.write_image(tmp_path / "b.exr", np.array([[["a"] * 3]]))
+    with pytest.raises(Exception, match="b.tiff"):
+        nimbus.write_image(tmp_path / "b.tiff", image)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.exr", "a.png"]
+
+
+def test_a_stopped_render_into_leaves_the_film_as_it_was():
+    scene = nimbus.load_file(DEMO, {"film.width": 128, "film.height": 128})
+    film = nimbus.Film(scene)
+    nimbus.render_into(scene, film, samples=(0, 1))
+    before = film.image()
+
+    def stop(done, total):
+        if done < total:
+            raise RuntimeError("stopped by the callback")
+
+    with pytest.raises(RuntimeError, match="stopped by the callback"):
+        nimbus.render_into(scene, film, samples=(1, 2000), progress=stop)
+    assert film.spp == 1
+    assert np.array_equal(film.image(), before)
