@@ -7,13 +7,16 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <exception>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -21,6 +24,8 @@
 #include <thread>
 #include <vector>
 
+#include "nimbus/frep/intersect.h"
+#include "nimbus/frep/tape.h"
 #include "nimbus/io/exr.h"
 #include "nimbus/io/film_file.h"
 #include "nimbus/io/film_image.h"
@@ -230,6 +235,73 @@ py::array_t<float> film_array(const Film& film, Values&& values) {
   return a;
 }
 
+// A shape of the scene format, compiled to its tape; F's values as written (FUse::Value).
+struct PyShape {
+  Tape tape;
+};
+
+PyShape make_shape(const std::string& shape, const std::string& shapes, const std::string& source) {
+  return {compile(
+      *load_shape_json(nlohmann::json::parse(shape),
+                       shapes.empty() ? nlohmann::json() : nlohmann::json::parse(shapes), source),
+      FUse::Value)};
+}
+
+using Rows = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// The rows of an (n, 3) array; ValueError naming the argument for another shape or a row that is
+// not finite.
+std::vector<Vec3> rows_of(const Rows& a, const std::string& name) {
+  if (a.ndim() != 2 || a.shape(1) != 3) {
+    std::string shape;
+    for (py::ssize_t i = 0; i < a.ndim(); ++i)
+      shape += (i ? ", " : "") + std::to_string(a.shape(i));
+    throw py::value_error(name + " must be an array of shape (n, 3), not (" + shape + ")");
+  }
+  std::vector<Vec3> rows(size_t(a.shape(0)));
+  const double* d = a.data();
+  for (size_t i = 0; i < rows.size(); ++i) {
+    rows[i] = {d[3 * i], d[3 * i + 1], d[3 * i + 2]};
+    if (!std::isfinite(rows[i].x) || !std::isfinite(rows[i].y) || !std::isfinite(rows[i].z))
+      throw py::value_error(name + "[" + std::to_string(i) + "] is not finite");
+  }
+  return rows;
+}
+
+py::array_t<double> shape_values(const PyShape& s, const Rows& points) {
+  const std::vector<Vec3> p = rows_of(points, "points");
+  py::array_t<double> out(py::ssize_t(p.size()));
+  double* f = out.mutable_data();
+  {
+    py::gil_scoped_release release;
+    tbb::parallel_for(size_t{0}, p.size(), [&](size_t i) { f[i] = evaluate(s.tape, p[i]); });
+  }
+  return out;
+}
+
+py::array_t<double> shape_first_hit(const PyShape& s, const Rows& origins, const Rows& directions,
+                                    double t_max) {
+  const std::vector<Vec3> o = rows_of(origins, "origins");
+  const std::vector<Vec3> d = rows_of(directions, "directions");
+  if (o.size() != d.size())
+    throw py::value_error("origins and directions must have as many rows (" +
+                          std::to_string(o.size()) + " and " + std::to_string(d.size()) + ")");
+  for (size_t i = 0; i < d.size(); ++i)
+    if (d[i] == Vec3{0, 0, 0})
+      throw py::value_error("directions[" + std::to_string(i) + "] is zero");
+  if (!(t_max >= 0)) throw py::value_error("t_max must be >= 0");
+  py::array_t<double> out(py::ssize_t(o.size()));
+  double* t = out.mutable_data();
+  {
+    py::gil_scoped_release release;
+    tbb::parallel_for(size_t{0}, o.size(), [&](size_t i) {
+      const std::optional<double> hit = first_hit(s.tape, Ray{o[i], d[i]}, 0, t_max);
+      t[i] = hit ? *hit : std::numeric_limits<double>::infinity();
+    });
+  }
+  return out;
+}
+
 }  // namespace nimbus_python
 
 PYBIND11_MODULE(_core, m) {
@@ -287,6 +359,21 @@ PYBIND11_MODULE(_core, m) {
       });
   m.def("render_into", &np::render_into_film, py::arg("scene"), py::arg("film"), py::arg("s0"),
         py::arg("s1"), py::arg("seed"), py::arg("threads"), py::arg("progress"));
+  py::class_<np::PyShape>(m, "Shape")
+      .def(py::init(&np::make_shape), py::arg("shape"), py::arg("shapes"), py::arg("source"))
+      .def("values", &np::shape_values, py::arg("points"))
+      .def("first_hit", &np::shape_first_hit, py::arg("origins"), py::arg("directions"),
+           py::arg("t_max"))
+      .def("bounds", [](const np::PyShape& s) -> py::object {
+        const nimbus::Bounds& b = s.tape.bounds;
+        if (b.box.empty()) return py::none();
+        const auto row = [](const nimbus::Vec3& v) {
+          py::array_t<double> a(3);
+          for (int i = 0; i < 3; ++i) a.mutable_data()[i] = v[i];
+          return a;
+        };
+        return py::make_tuple(row(b.box.lo), row(b.box.hi));
+      });
   m.def(
       "write_image",
       [](const std::string& path, py::array_t<float, py::array::c_style> a) {

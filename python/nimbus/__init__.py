@@ -15,7 +15,7 @@ import time as _time
 from . import _core
 from ._core import Film, JobError, Scene, SceneError, __version__
 
-__all__ = ["Scene", "SceneError", "JobError", "Film", "load_file", "load_dict", "render",
+__all__ = ["Scene", "SceneError", "JobError", "Film", "Shape", "load_file", "load_dict", "render",
            "render_into", "write_image", "read_exr", "__version__"]
 
 
@@ -144,6 +144,48 @@ def write_image(path, array):
     if a.ndim != 3 or a.shape[2] != 3 or a.shape[0] < 1 or a.shape[1] < 1:
         raise ValueError(f"an image is an array of shape (height, width, 3), not {a.shape}")
     _core.write_image(_os.fspath(path), np.ascontiguousarray(a, dtype=np.float32))
+
+
+class Shape:
+    """A shape of the scene format (docs/scene-format.md, "Shapes"), compiled as nimbus renders it.
+
+        blob = nimbus.Shape({"type": "freeform", "base": {"type": "sphere", "radius": 1},
+                             "perturbations": [{"shape": "bump", "weight": 2}]},
+                            shapes={"bump": {"type": "sphere", "center": [1, 0, 0], "radius": 0.5}})
+        f = blob.values(points)                  # F at an (n, 3) array: (n,), > 0 inside
+        t = blob.first_hit(origins, directions)  # (n,), inf where a ray misses
+
+    `shape` is a shape value (a dict) or the name of one in `shapes`, a dict of named shapes as
+    the scene file's table. Errors are SceneError lines: "<shape>: /shape/radius: must be in [1e-100, 1e+100]".
+    F is the function as written: quadrics keep their coefficients' scale (no normalisation).
+    The vectorised calls release the GIL and run on all cores.
+    """
+
+    def __init__(self, shape, shapes=None, source="<shape>"):
+        if not isinstance(shape, (dict, str)):
+            raise TypeError(f"a shape is a dict (or a name in shapes), not {type(shape).__name__}")
+        if shapes is not None and not isinstance(shapes, dict):
+            raise TypeError(f"shapes must be a dict of named shapes, not {type(shapes).__name__}")
+        try:
+            text = _json.dumps(shape, allow_nan=False)
+            table = "" if shapes is None else _json.dumps(shapes, allow_nan=False)
+        except (TypeError, ValueError) as e:
+            raise SceneError(f"{source}: not a JSON document ({e})") from None
+        self._shape = _core.Shape(text, table, source)
+
+    def values(self, points):
+        """F at each row of an (n, 3) array of points (float64): an (n,) array, > 0 inside."""
+        return self._shape.values(points)
+
+    def first_hit(self, origins, directions, t_max=float("inf")):
+        """The first t in [0, t_max] where each ray o + t d crosses the surface: (n,), inf where
+        it does not. origins and directions are (n, 3) arrays; directions need not be unit."""
+        return self._shape.first_hit(origins, directions, float(t_max))
+
+    def bounds(self):
+        """(lo, hi), each a float64 array of 3, around {F > 0}; +-inf where unbounded; None when
+        the shape is empty."""
+        return self._shape.bounds()
 
 
 def read_exr(path):

@@ -222,3 +222,102 @@ def test_a_stopped_render_into_leaves_the_film_as_it_was():
         nimbus.render_into(scene, film, samples=(1, 2000), progress=stop)
     assert film.spp == 1
     assert np.array_equal(film.image(), before)
+
+
+def sphere_f(p, c, r):
+    return r * r - np.sum((p - np.asarray(c)) ** 2, axis=1)
+
+
+BLOB = {"type": "freeform", "base": {"type": "sphere", "radius": 1},
+        "perturbations": [{"shape": "bump", "weight": 2},
+                          {"shape": {"type": "sphere", "center": [-0.5, 0.6, 0.4], "radius": 0.5},
+                           "weight": -3}]}
+NAMED = {"bump": {"type": "sphere", "center": [0.8, 0.3, 0], "radius": 0.5}}
+CARVED = {"type": "difference", "shapes": [
+    {"type": "union", "shapes": [{"type": "sphere", "radius": 1},
+                                 {"type": "sphere", "center": [1.2, 0, 0], "radius": 0.6}]},
+    {"type": "sphere", "center": [0, 0, 1], "radius": 0.7}]}
+
+
+def blob_f(p):
+    bump = lambda c, r: np.maximum(sphere_f(p, c, r), 0) ** 3  # noqa: E731
+    return sphere_f(p, [0, 0, 0], 1) + 2 * bump([0.8, 0.3, 0], 0.5) - 3 * bump([-0.5, 0.6, 0.4], 0.5)
+
+
+def carved_f(p):
+    union = np.maximum(sphere_f(p, [0, 0, 0], 1), sphere_f(p, [1.2, 0, 0], 0.6))
+    return np.minimum(union, -sphere_f(p, [0, 0, 1], 0.7))
+
+
+def test_shape_values_are_a_numpy_evaluation_of_the_same_function():
+    points = np.random.default_rng(3).uniform(-2, 2, (5000, 3))
+    for shape, f in [(nimbus.Shape(BLOB, NAMED), blob_f), (nimbus.Shape(CARVED), carved_f)]:
+        values = shape.values(points)
+        assert values.shape == (5000,) and values.dtype == np.float64
+        assert np.allclose(values, f(points), rtol=1e-12, atol=1e-12)
+        assert (values > 0).any() and (values < 0).any()
+    moved = nimbus.Shape({"type": "union", "shapes": ["bump"],
+                          "transform": [{"translate": [1, 2, 3]}]}, NAMED)
+    assert np.allclose(moved.values(points), sphere_f(points, [1.8, 2.3, 3], 0.5), atol=1e-12)
+
+
+def test_first_hit_is_where_dense_sampling_finds_the_first_crossing():
+    rng = np.random.default_rng(7)
+    origins = rng.normal(size=(300, 3))
+    origins = 3 * origins / np.linalg.norm(origins, axis=1, keepdims=True)
+    targets = rng.uniform(-0.8, 0.8, (300, 3))
+    directions = targets - origins
+    directions[::10] *= -1  # these point away: they miss
+    for shape, f in [(nimbus.Shape(BLOB, NAMED), blob_f), (nimbus.Shape(CARVED), carved_f)]:
+        t = shape.first_hit(origins, directions, t_max=2.0)
+        steps = np.linspace(0, 2.0, 20001)
+        hits = 0
+        for i in range(len(origins)):
+            along = f(origins[i] + steps[:, None] * directions[i])
+            change = np.nonzero(np.sign(along[1:]) != np.sign(along[:-1]))[0]
+            if len(change) == 0:
+                assert t[i] == np.inf, i
+                continue
+            hits += 1
+            k = change[0]
+            assert steps[k] - 1e-9 <= t[i] <= steps[k + 1] + 1e-9, (i, t[i], steps[k])
+        assert hits > 200
+
+
+def test_shape_bounds_hold_the_inside():
+    shape = nimbus.Shape(BLOB, NAMED)
+    lo, hi = shape.bounds()
+    points = np.random.default_rng(5).uniform(-2, 2, (20000, 3))
+    inside = points[shape.values(points) > 0]
+    assert len(inside) > 1000
+    assert (inside >= lo).all() and (inside <= hi).all()
+    assert nimbus.Shape({"type": "intersection", "shapes": [
+        {"type": "sphere", "radius": 1}, {"type": "sphere", "center": [5, 0, 0], "radius": 1}]}
+    ).bounds() is None
+    lo, hi = nimbus.Shape({"type": "halfspace", "normal": [0, 1, 0]}).bounds()
+    assert np.isinf(lo).any() and np.isinf(hi).any()
+
+
+def test_bad_shapes_and_arrays_are_refused():
+    with pytest.raises(nimbus.SceneError, match=r"^<shape>: /shape/radius: must be in \[1e-100"):
+        nimbus.Shape({"type": "sphere", "radius": -1})
+    with pytest.raises(nimbus.SceneError, match=r'unknown shape "nope"'):
+        nimbus.Shape("nope")
+    with pytest.raises(nimbus.SceneError, match=r"^<shape>: /shapes/bump/radius"):
+        nimbus.Shape("bump", {"bump": {"type": "sphere"}})
+    with pytest.raises(TypeError):
+        nimbus.Shape(3)
+    shape = nimbus.Shape(BLOB, NAMED)
+    with pytest.raises(ValueError, match=r"points must be an array of shape \(n, 3\), not \(3, 2\)"):
+        shape.values(np.zeros((3, 2)))
+    bad = np.zeros((3, 3))
+    bad[1, 2] = np.nan
+    with pytest.raises(ValueError, match=r"points\[1\] is not finite"):
+        shape.values(bad)
+    with pytest.raises(ValueError, match=r"directions\[0\] is zero"):
+        shape.first_hit(np.ones((2, 3)), np.zeros((2, 3)))
+    with pytest.raises(ValueError, match="as many rows"):
+        shape.first_hit(np.ones((2, 3)), np.ones((3, 3)))
+    with pytest.raises(ValueError, match="t_max"):
+        shape.first_hit(np.ones((2, 3)), np.ones((2, 3)), t_max=float("nan"))
+    assert shape.values(np.zeros((0, 3))).shape == (0,)

@@ -184,6 +184,24 @@ class Loader {
     return scene;
   }
 
+  // A document {"shape": SHAPE, "shapes": {NAME: SHAPE, ...}}: the shape, its names resolved in
+  // the table (load_shape_json).
+  ShapePtr load_shape() {
+    const auto shapes = root_.optional("shapes");
+    const JsonValue value = root_.required("shape");
+    root_.finish();
+    if (shapes) {
+      shapes_.emplace(*shapes);
+      for (const auto& [name, named] : shapes_->entries()) named_shape(name, named);
+    }
+    ShapePtr s = shape(value);
+    if (count_quadrics(*s) > kMaxTapeQuadrics)
+      value.fail(
+          fmt::format("the shape holds more than {} quadrics (each use of a named shape counts)",
+                      kMaxTapeQuadrics));
+    return s;
+  }
+
  private:
   static CameraDesc read_camera(const JsonValue& v) {
     JsonObject o(v);
@@ -757,6 +775,14 @@ SceneDesc load_json_in(nlohmann::json j, const std::string& source, const std::s
 }
 
 }  // namespace
+
+ShapePtr load_shape_json(const nlohmann::json& shape, const nlohmann::json& shapes,
+                         const std::string& source) {
+  nlohmann::json document = {{"shape", shape}};
+  if (!shapes.is_null()) document["shapes"] = shapes;
+  const JsonOrigin origin{source, {}, ""};
+  return Loader(JsonValue(document, "", origin)).load_shape();
+}
 
 SceneDesc load_scene_json(nlohmann::json j, const std::string& source,
                           const std::vector<std::string>& overrides) {

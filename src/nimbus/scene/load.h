@@ -64,6 +64,12 @@ SceneDesc load_scene_text(const std::string& text, const std::string& source,
 SceneDesc load_scene_json(nlohmann::json j, const std::string& source,
                           const std::vector<std::string>& overrides = {});
 
+// One shape of the scene format on its own (Python's nimbus.Shape): `shape` a shape value, named
+// shapes it refers to in `shapes` (a table as the scene file's, or null), checked as in a scene
+// file; messages read "SOURCE: /shape/...: problem" or "SOURCE: /shapes/NAME/...: problem".
+ShapePtr load_shape_json(const nlohmann::json& shape, const nlohmann::json& shapes,
+                         const std::string& source);
+
 // A "transform" value (docs/scene-format.md): steps applied in the listed order; a degenerate one
 // fails. Shapes and the "vdb" density read it.
 Mat4 read_transform(const JsonValue& v);
