@@ -24,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "nimbus/experiments/experiment.h"
 #include "nimbus/frep/intersect.h"
 #include "nimbus/frep/tape.h"
 #include "nimbus/io/exr.h"
@@ -31,6 +32,7 @@
 #include "nimbus/io/film_image.h"
 #include "nimbus/io/output.h"
 #include "nimbus/job/render_job.h"
+#include "nimbus/media/medium_field.h"
 #include "nimbus/render/renderer.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
@@ -302,12 +304,61 @@ py::array_t<double> shape_first_hit(const PyShape& s, const Rows& origins, const
   return out;
 }
 
+// The media's coefficients at points, in rgb, as a path finds them there: each present
+// medium's density times its sigma_a and sigma_s, summed (the index-matched media add), inside a
+// solid only its own medium. Returns (sigma_a, sigma_s), each (n, 3).
+py::tuple media_at(const PyScene& scene, const Rows& points) {
+  const std::vector<Vec3> p = rows_of(points, "points");
+  const auto compiled = compiled_scene(scene, std::nullopt);
+  py::array_t<double> sigma_a({py::ssize_t(p.size()), py::ssize_t(3)});
+  py::array_t<double> sigma_s({py::ssize_t(p.size()), py::ssize_t(3)});
+  double* a = sigma_a.mutable_data();
+  double* b = sigma_s.mutable_data();
+  {
+    py::gil_scoped_release release;
+    const Scene& sc = *compiled;
+    tbb::parallel_for(size_t{0}, p.size(), [&](size_t i) {
+      Rgb mu_a(0.0), mu_s(0.0);
+      for_each_medium_at(sc, p[i], solid_containing(sc, p[i]), [&](int m, double density) {
+        mu_a += sc.media[size_t(m)].sigma_a.rgb * density;
+        mu_s += sc.media[size_t(m)].sigma_s.rgb * density;
+      });
+      for (int c = 0; c < 3; ++c) {
+        a[3 * i + c] = mu_a[c];
+        b[3 * i + c] = mu_s[c];
+      }
+    });
+  }
+  return py::make_tuple(sigma_a, sigma_s);
+}
+
+// Runs experiment `name` (docs/reproduction.md) into `out`; returns its files and summary.
+py::tuple run_experiment(const std::string& name, const std::filesystem::path& out,
+                         const std::filesystem::path& scenes, bool quick, uint64_t seed,
+                         int threads) {
+  for (const Experiment& e : experiments()) {
+    if (e.name != name) continue;
+    ExperimentReport report;
+    {
+      py::gil_scoped_release release;
+      report = e.run(ExperimentOptions{out, scenes, quick, seed, threads});
+    }
+    std::vector<std::string> files;
+    for (const auto& f : report.files) files.push_back(f.string());
+    return py::make_tuple(files, report.summary);
+  }
+  std::string names;
+  for (const Experiment& e : experiments()) names += (names.empty() ? "" : ", ") + e.name;
+  throw py::value_error("unknown experiment \"" + name + "\" (expected one of: " + names + ")");
+}
+
 }  // namespace nimbus_python
 
 PYBIND11_MODULE(_core, m) {
   namespace np = nimbus_python;
   m.doc() = "The compiled part of nimbus; use the package nimbus.";
   m.attr("__version__") = NIMBUS_VERSION;
+  m.attr("_build_scenes_dir") = NIMBUS_SCENES_DIR;
   // One line naming the place and the problem, as the command line prints it.
   py::register_exception<nimbus::SceneError>(m, "SceneError", PyExc_ValueError);
   py::register_exception<nimbus::JobError>(m, "JobError", PyExc_RuntimeError);
@@ -317,6 +368,8 @@ PYBIND11_MODULE(_core, m) {
       .def_readonly("spp", &np::PyScene::spp)
       .def_readonly("seed", &np::PyScene::seed)
       .def_readonly("source", &np::PyScene::source)
+      .def("media_at", &np::media_at, py::arg("points"),
+           "The media's rgb sigma_a and sigma_s at an (n, 3) array of points: two (n, 3) arrays.")
       .def("__repr__", [](const np::PyScene& s) {
         return "<nimbus.Scene " + s.source + ": " + std::to_string(s.width) + "x" +
                std::to_string(s.height) + ", " + std::to_string(s.spp) + " spp>";
@@ -374,6 +427,13 @@ PYBIND11_MODULE(_core, m) {
         };
         return py::make_tuple(row(b.box.lo), row(b.box.hi));
       });
+  m.def("run_experiment", &np::run_experiment, py::arg("name"), py::arg("out"), py::arg("scenes"),
+        py::arg("quick"), py::arg("seed"), py::arg("threads"));
+  m.def("experiment_names", [] {
+    std::vector<std::string> names;
+    for (const nimbus::Experiment& e : nimbus::experiments()) names.push_back(e.name);
+    return names;
+  });
   m.def(
       "write_image",
       [](const std::string& path, py::array_t<float, py::array::c_style> a) {

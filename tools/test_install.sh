@@ -46,4 +46,13 @@ PKG_CONFIG_PATH="$prefix/lib/pkgconfig" pkg-config --cflags --libs nimbus | grep
 # The installed executable runs an experiment from the installed scenes, away from the checkout.
 (cd "$work" && "$prefix/bin/nimbus" experiment segments --quick --no-plot --out "$work/exp" > /dev/null)
 [ -s "$work/exp/segments.csv" ] || { echo "test_install: the installed nimbus ran no experiment" >&2; exit 1; }
+# The Python package, where the build has it: installed in Debian's layout, imported from there
+# alone, running an experiment from the installed scenes.
+python="$prefix/lib/python3/dist-packages"
+if [ -d "$build/python/nimbus" ]; then
+  [ -f "$python/nimbus/__init__.py" ] || { echo "test_install: the Python package was not installed" >&2; exit 1; }
+  (cd "$work" && PYTHONPATH="$python" /usr/bin/python3 -c \
+    "import nimbus; assert nimbus.__file__.startswith('$python'); nimbus.experiment('segments', quick=True)") ||
+    { echo "test_install: the installed Python package does not run" >&2; exit 1; }
+fi
 echo "test_install: installed, built examples/embed outside the tree, rendered, ran an experiment"

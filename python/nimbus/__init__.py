@@ -16,7 +16,8 @@ from . import _core
 from ._core import Film, JobError, Scene, SceneError, __version__
 
 __all__ = ["Scene", "SceneError", "JobError", "Film", "Shape", "load_file", "load_dict", "render",
-           "render_into", "write_image", "read_exr", "__version__"]
+           "render_into", "write_image", "read_exr", "experiment", "experiment_names",
+           "__version__"]
 
 
 def _overrides(overrides):
@@ -186,6 +187,55 @@ class Shape:
         """(lo, hi), each a float64 array of 3, around {F > 0}; +-inf where unbounded; None when
         the shape is empty."""
         return self._shape.bounds()
+
+
+def experiment_names():
+    """The paper-reproduction experiments (docs/reproduction.md), in the order of its figures."""
+    return list(_core.experiment_names())
+
+
+def _scenes_dir():
+    """scenes/ of an installed prefix (PREFIX/share/nimbus beside lib/python3/dist-packages),
+    else the build tree's."""
+    here = _os.path.dirname(_os.path.abspath(__file__))
+    installed = _os.path.join(here, "..", "..", "..", "..", "share", "nimbus", "scenes")
+    return installed if _os.path.isdir(installed) else _core._build_scenes_dir
+
+
+def _read_csv(path):
+    """A CSV file's columns as arrays: numbers as float64, anything else as str."""
+    import csv
+    import numpy as np
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    if not rows:
+        return {}
+    columns = {}
+    for k, name in enumerate(rows[0]):
+        cells = [r[k] if k < len(r) else "" for r in rows[1:]]
+        try:
+            columns[name] = np.array([float(c) for c in cells])
+        except ValueError:
+            columns[name] = np.array(cells)
+    return columns
+
+
+def experiment(name, quick=False, seed=0, threads=None):
+    """Runs `nimbus experiment NAME` and returns what it writes as CSV as arrays:
+    {"summary": str, CSV_STEM: {column: array}, ...}. The GIL is released while it runs."""
+    import tempfile
+    if not isinstance(name, str):
+        raise TypeError(f"an experiment's name is a str, not {type(name).__name__}")
+    seed = _count("seed", seed, 0, 2**64 - 1)
+    threads = _count("threads", threads, 1, 4096)
+    with tempfile.TemporaryDirectory(prefix="nimbus-experiment-") as out:
+        files, summary = _core.run_experiment(name, out, _scenes_dir(), bool(quick), seed,
+                                              threads or 0)
+        result = {"summary": summary}
+        for path in files:
+            if path.endswith(".csv"):
+                result[_os.path.splitext(_os.path.basename(path))[0]] = _read_csv(path)
+    return result
 
 
 def read_exr(path):

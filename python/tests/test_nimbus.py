@@ -321,3 +321,39 @@ def test_bad_shapes_and_arrays_are_refused():
     with pytest.raises(ValueError, match="t_max"):
         shape.first_hit(np.ones((2, 3)), np.ones((2, 3)), t_max=float("nan"))
     assert shape.values(np.zeros((0, 3))).shape == (0,)
+
+
+def test_media_at_points_add_where_media_overlap():
+    document = {
+        "camera": {"from": [0, 0, 5], "to": [0, 0, 0]},
+        "media": {"a": {"sigma_a": [1, 2, 3], "sigma_s": [4, 5, 6]},
+                  "b": {"sigma_a": 0.5, "sigma_s": 0.25},
+                  "glass": {"sigma_a": 7, "sigma_s": 8}},
+        "objects": [
+            {"shape": {"type": "sphere", "center": [-0.5, 0, 0], "radius": 1}, "medium": "a"},
+            {"shape": {"type": "sphere", "center": [0.5, 0, 0], "radius": 1}, "medium": "b"},
+            {"shape": {"type": "sphere", "center": [5, 0, 0], "radius": 1}, "medium": "glass",
+             "surface": {"type": "dielectric"}}]}
+    scene = nimbus.load_dict(document)
+    points = np.array([[-1.2, 0, 0], [0, 0, 0], [1.2, 0, 0], [0, 3, 0], [5, 0, 0]])
+    sigma_a, sigma_s = scene.media_at(points)
+    assert np.allclose(sigma_a, [[1, 2, 3], [1.5, 2.5, 3.5], [0.5] * 3, [0] * 3, [7] * 3])
+    assert np.allclose(sigma_s, [[4, 5, 6], [4.25, 5.25, 6.25], [0.25] * 3, [0] * 3, [8] * 3])
+    with pytest.raises(ValueError, match="points must be an array"):
+        scene.media_at(np.zeros(3))
+
+
+def test_experiments_return_the_command_lines_csv_as_arrays(tmp_path):
+    assert "throughput" in nimbus.experiment_names()
+    result = nimbus.experiment("throughput", quick=True, seed=3)
+    subprocess.run([EXE, "experiment", "throughput", "--quick", "--seed", "3", "--no-plot",
+                    "--out", str(tmp_path)], check=True, capture_output=True)
+    import csv
+    with open(tmp_path / "throughput.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    columns = result["throughput"]
+    assert len(columns["mean"]) == len(rows) > 0
+    assert np.array_equal(columns["mean"], [float(r["mean"]) for r in rows])
+    assert list(columns["channel"]) == [r["channel"] for r in rows]
+    with pytest.raises(ValueError, match="unknown experiment \"nope\""):
+        nimbus.experiment("nope")
