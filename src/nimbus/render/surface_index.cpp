@@ -162,6 +162,10 @@ SurfaceIndex build_surface_index(const std::vector<SceneObject>& objects,
       items.push_back({b, b.center(), 0});
     }
   for (size_t i = 0; i < items.size(); ++i) items[i].id = static_cast<std::uint32_t>(i);
+  // A surface with an empty box can never be hit (e.g. a sphere below a double's resolution far
+  // from the origin, built in code; compile_scene drops those): it has no entry, and no centroid
+  // (an empty box's is NaN) to bin.
+  std::erase_if(items, [](const SurfaceItem& item) { return item.bounds.empty(); });
   index.object_count = objects.size();
   index.light_count = lights.size();
   if (items.empty()) return index;

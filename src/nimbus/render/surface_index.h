@@ -33,7 +33,8 @@ struct SurfaceNode {
 struct SurfaceIndex {
   std::vector<int> objects;  // indices of the scene's objects with a surface, in scene order
   std::vector<int> lights;   // indices of its lights with a surface (has_surface), in order
-  // The surfaces in leaf order, each as its position in the list objects-then-lights.
+  // The surfaces in leaf order, each as its position in the list objects-then-lights; those with
+  // an empty box, which nothing hits, are left out.
   std::vector<std::uint32_t> entries;
   std::vector<SurfaceNode> nodes;  // nodes[0] is the root; empty when there is no surface
   // The sizes it was built for: render_into refuses a scene changed since (finish_scene).
