@@ -28,6 +28,7 @@
 #include "cluster.h"
 #include "nimbus/experiments/experiment.h"
 #include "nimbus/io/atomic_file.h"
+#include "nimbus/io/display_server.h"
 #include "nimbus/io/film_image.h"
 #include "nimbus/io/output.h"
 #include "nimbus/io/vdb_export.h"
@@ -58,6 +59,7 @@ struct RenderArgs {
   std::string checkpoint;
   double checkpoint_interval = 0;  // 0: not given (60 s)
   std::string resume;
+  std::string display_server;  // HOST:PORT of a tev viewer; "": none
 };
 
 // SIGINT, SIGTERM and SIGHUP: the first one during a render stops it before its next pixel
@@ -316,6 +318,24 @@ int run_render(const RenderArgs& args, const Cluster& cluster) {
   }
   const bool show_progress = lead && !args.quiet && isatty(fileno(stderr));
   if (show_progress) options.progress = progress_bar("render");
+  // The render shown in tev as it refines (io/display_server.h): rank 0's film.
+  std::unique_ptr<DisplayServer> display;
+  if (!args.display_server.empty()) {
+    Outcome address;
+    if (lead) {
+      const std::string name =
+          std::filesystem::path(args.outputs.empty() ? args.scene : args.outputs.front())
+              .filename()
+              .string();
+      try {
+        display = std::make_unique<DisplayServer>(args.display_server, name, options.warning);
+        options.display = [&display](const Film& film) { display->update(film); };
+      } catch (const std::invalid_argument& e) {
+        address = {kExitBadInput, fmt::format("nimbus: {}", e.what())};
+      }
+    }
+    if (const int code = agree(cluster, address); code != 0) return code;
+  }
   RenderJob job(options);
 
   int spp = args.spp;
@@ -378,6 +398,7 @@ int run_render(const RenderArgs& args, const Cluster& cluster) {
     return receive_exit_code();
   }
   const JobOutcome r = job.run(cluster.mpi ? &channel : nullptr);
+  if (display) display->finish(r.film);
   if (show_progress) std::fprintf(stderr, "\n");
   const int code = finish_render(args, job, outputs, r);
   send_exit_code(cluster, code);
@@ -667,6 +688,8 @@ int run_command(int argc, char** argv, const Cluster& cluster) {
       ->add_option("--checkpoint-interval", args.checkpoint_interval,
                    "Seconds between checkpoints (default 60)")
       ->check(positive_seconds());
+  render->add_option("--display-server", args.display_server,
+                     "Stream the render to a tev viewer at HOST:PORT as it refines (docs/cli.md)");
   render->add_option("--resume", args.resume,
                      "Continue the render of this checkpoint up to --spp (default: the spp it "
                      "was started with); later checkpoints go to the same file unless "

@@ -143,8 +143,8 @@ void RenderJob::check_compiled() const {
 
 JobOutcome RenderJob::run(JobChannel* channel) {
   if (!compiled_) throw std::logic_error("RenderJob::run before the scene was compiled");
-  // One call of the renderer, over tiles, unless units must be shared or checkpointed.
-  if (!channel && checkpoint_file_.empty()) return run_at_once();
+  // One call of the renderer, over tiles, unless units must be shared, checkpointed or shown.
+  if (!channel && checkpoint_file_.empty() && !options_.display) return run_at_once();
   return run_shared(channel);
 }
 
@@ -168,6 +168,7 @@ JobOutcome RenderJob::run_shared(JobChannel* channel) {
   s.spp = scene_.settings.spp;
   s.threads = options_.threads;
   s.start = resumed_ ? resumed_->film : make_film(scene_);
+  s.display = options_.display;
   const uint64_t held_at_start = samples_held(s.start);
   // Why the last checkpoint could not be saved; empty: it was, or none was due.
   auto failure = std::make_shared<std::string>();

@@ -52,6 +52,9 @@ struct RenderJobOptions {
   std::function<void(double)> progress;  // the fraction done, now and then
   std::function<bool()> cancel;          // polled; true stops the job
   std::function<void(const std::string&)> warning;  // a problem the job survives, one line
+  // Called a few times a second and at the end with the film so far (complete work units), on
+  // the lead: --display-server (io/display_server.h). Set, the job renders in units.
+  std::function<void(const Film&)> display;
 };
 
 struct JobOutcome {

@@ -86,6 +86,7 @@ void serve(WorkQueue& queue, JobChannel* channel, const SharedRenderSettings& s,
   int gone = 0;              // ranks that were told the job is over, or left it
   auto last_checkpoint = Clock::now();
   auto last_progress = Clock::time_point{};
+  auto last_display = Clock::time_point{};
   for (;;) {
     if (stop() && !queue.stopped()) queue.stop();
     while (std::optional<JobChannel::Message> m =
@@ -125,6 +126,10 @@ void serve(WorkQueue& queue, JobChannel* channel, const SharedRenderSettings& s,
     if (s.progress && seconds_since(last_progress) > 0.1) {
       s.progress(queue.fraction_done());
       last_progress = Clock::now();
+    }
+    if (s.display && !over && seconds_since(last_display) >= s.display_interval) {
+      queue.with_film(s.display);
+      last_display = Clock::now();
     }
     if (s.checkpoint && !over && seconds_since(last_checkpoint) >= s.checkpoint_interval) {
       queue.with_film(s.checkpoint);
@@ -179,6 +184,7 @@ SharedRenderResult lead_shared_render(const Scene& scene, JobChannel* channel,
   result.stopped = !queue.finished();
   if (s.progress && !result.stopped) s.progress(1.0);
   if (s.checkpoint) queue.with_film(s.checkpoint);
+  if (s.display) queue.with_film(s.display);  // the last update: the film written
   result.film = queue.film();
   result.counters = queue.counters();
   result.samples_per_rank = queue.samples_per_rank();

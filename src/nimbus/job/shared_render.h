@@ -24,6 +24,10 @@ struct SharedRenderSettings {
   // (which holds only complete units); none: no checkpoints.
   std::function<void(const Film&)> checkpoint;
   double checkpoint_interval = 60;
+  // Called on the lead every `display_interval` seconds and at the end, with the film (complete
+  // units only), to show the render as it refines (io/display_server.h); none: not shown.
+  std::function<void(const Film&)> display;
+  double display_interval = 0.25;
   std::function<void(double)> progress;  // fraction of the job done, on the lead
   std::function<bool()> stop;            // polled; true: stop handing out and rendering units
 };

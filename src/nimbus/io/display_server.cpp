@@ -1,0 +1,184 @@
+#include "nimbus/io/display_server.h"
+
+#include <fcntl.h>
+#include <netdb.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <sys/types.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <stdexcept>
+
+namespace nimbus {
+namespace {
+
+enum PacketType : std::uint8_t { kCreateImage = 4, kUpdateImage = 6 };
+
+constexpr double kRetrySeconds = 2;     // between attempts to reach an absent viewer
+constexpr int kConnectTimeoutMs = 200;  // a viewer on another host may take this long to answer
+constexpr int kSendTimeoutSeconds = 2;  // a viewer that stops reading is dropped after this
+
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Little-endian packet writer: tev's wire format.
+struct Packet {
+  std::vector<std::uint8_t> bytes{0, 0, 0, 0};  // the length, filled in by done()
+  template <class T>
+  void put(T value) {
+    std::uint8_t b[sizeof(T)];
+    std::memcpy(b, &value, sizeof(T));  // x86-64 and aarch64 are little-endian
+    bytes.insert(bytes.end(), b, b + sizeof(T));
+  }
+  void put_string(const std::string& s) {
+    bytes.insert(bytes.end(), s.begin(), s.end());
+    bytes.push_back(0);
+  }
+  std::vector<std::uint8_t>& done() {
+    const auto n = static_cast<std::uint32_t>(bytes.size());
+    std::memcpy(bytes.data(), &n, 4);
+    return bytes;
+  }
+};
+
+}  // namespace
+
+DisplayServer::DisplayServer(const std::string& address, std::string name,
+                             std::function<void(const std::string&)> warn)
+    : address_(address), name_(std::move(name)), warn_(std::move(warn)) {
+  const auto colon = address.rfind(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 == address.size())
+    throw std::invalid_argument("--display-server " + address + ": expected HOST:PORT");
+  host_ = address.substr(0, colon);
+  port_ = address.substr(colon + 1);
+  if (port_.find_first_not_of("0123456789") != std::string::npos || port_.size() > 5 ||
+      std::stoi(port_) < 1 || std::stoi(port_) > 65535)
+    throw std::invalid_argument("--display-server " + address +
+                                ": the port must be a number in [1, 65535]");
+}
+
+DisplayServer::~DisplayServer() {
+  if (socket_ >= 0) ::close(socket_);
+}
+
+void DisplayServer::drop(const std::string& why) {
+  if (socket_ >= 0) ::close(socket_);
+  socket_ = -1;
+  next_attempt_ = now_seconds() + kRetrySeconds;
+  if (!warned_ && warn_)
+    warn_("--display-server " + address_ + ": " + why + "; the render goes on without it");
+  warned_ = true;
+}
+
+bool DisplayServer::connect_once() {
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  addrinfo* found = nullptr;
+  if (const int e = ::getaddrinfo(host_.c_str(), port_.c_str(), &hints, &found); e != 0) {
+    drop(std::string("cannot resolve the host (") + ::gai_strerror(e) + ")");
+    return false;
+  }
+  std::string why = "no address";
+  for (addrinfo* a = found; a; a = a->ai_next) {
+    const int s = ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
+    if (s < 0) continue;
+    // Non-blocking connect with a timeout: an unreachable host must not stall the render.
+    const int flags = ::fcntl(s, F_GETFL);
+    ::fcntl(s, F_SETFL, flags | O_NONBLOCK);
+    int error = 0;
+    if (::connect(s, a->ai_addr, a->ai_addrlen) != 0) {
+      error = errno;
+      if (error == EINPROGRESS) {
+        pollfd p{s, POLLOUT, 0};
+        error = ::poll(&p, 1, kConnectTimeoutMs) == 1 ? 0 : ETIMEDOUT;
+        socklen_t len = sizeof(int);
+        if (error == 0) ::getsockopt(s, SOL_SOCKET, SO_ERROR, &error, &len);
+      }
+    }
+    if (error == 0) {
+      ::fcntl(s, F_SETFL, flags);
+      const timeval timeout{kSendTimeoutSeconds, 0};
+      ::setsockopt(s, SOL_SOCKET, SO_SNDTIMEO, &timeout, sizeof timeout);
+      socket_ = s;
+      ::freeaddrinfo(found);
+      return true;
+    }
+    why = std::strerror(error);
+    ::close(s);
+  }
+  ::freeaddrinfo(found);
+  drop("cannot connect (" + why + ")");
+  return false;
+}
+
+bool DisplayServer::send_all(const std::vector<std::uint8_t>& packet) {
+  for (size_t sent = 0; sent < packet.size();) {
+    const ssize_t n = ::send(socket_, packet.data() + sent, packet.size() - sent, MSG_NOSIGNAL);
+    if (n <= 0) {
+      drop(std::string("the viewer went away (") + (n < 0 ? std::strerror(errno) : "closed") + ")");
+      return false;
+    }
+    sent += size_t(n);
+  }
+  return true;
+}
+
+void DisplayServer::finish(const Film& film) {
+  next_attempt_ = 0;
+  update(film);
+}
+
+void DisplayServer::update(const Film& film) {
+  const bool fresh = socket_ < 0;
+  if (fresh) {
+    if (now_seconds() < next_attempt_ || !connect_once()) return;
+    Packet create;
+    create.put(kCreateImage);
+    create.put<std::uint8_t>(1);  // grab focus
+    create.put_string(name_);
+    create.put<std::int32_t>(film.width);
+    create.put<std::int32_t>(film.height);
+    create.put<std::int32_t>(3);
+    for (const char* c : {"R", "G", "B"}) create.put_string(c);
+    if (!send_all(create.done())) return;
+    sent_samples_.assign(size_t(film.pixels()), 0);
+  }
+  for (int y0 = 0; y0 < film.height; y0 += kDisplayTile) {
+    for (int x0 = 0; x0 < film.width; x0 += kDisplayTile) {
+      const int w = std::min(kDisplayTile, film.width - x0);
+      const int h = std::min(kDisplayTile, film.height - y0);
+      bool changed = fresh;
+      for (int y = y0; y < y0 + h && !changed; ++y)
+        for (int x = x0; x < x0 + w && !changed; ++x)
+          changed =
+              film.samples[size_t(y) * film.width + x] != sent_samples_[size_t(y) * film.width + x];
+      if (!changed) continue;
+      Packet tile;
+      tile.put(kUpdateImage);
+      tile.put<std::uint8_t>(0);
+      tile.put_string(name_);
+      tile.put<std::int32_t>(3);
+      for (const char* c : {"R", "G", "B"}) tile.put_string(c);
+      for (const int v : {x0, y0, w, h}) tile.put<std::int32_t>(v);
+      for (std::int64_t c = 0; c < 3; ++c) tile.put<std::int64_t>(c);  // offsets
+      for (int c = 0; c < 3; ++c) tile.put<std::int64_t>(3);           // strides
+      for (int y = y0; y < y0 + h; ++y)
+        for (int x = x0; x < x0 + w; ++x) {
+          const int p = y * film.width + x;
+          const Rgb m = film.mean(p);  // as to_image converts it
+          for (int c = 0; c < 3; ++c) tile.put(static_cast<float>(m[c]));
+          sent_samples_[size_t(p)] = film.samples[size_t(p)];
+        }
+      if (!send_all(tile.done())) return;
+      ++tiles_sent_;
+    }
+  }
+  warned_ = false;
+}
+
+}  // namespace nimbus

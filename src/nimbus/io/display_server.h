@@ -1,0 +1,55 @@
+#pragma once
+// Streaming a render to the tev viewer (github.com/Tom94/tev) while it runs, as pbrt-v4's
+// --display-server does: tev's IPC protocol over TCP, each packet a little-endian uint32 of its
+// whole length and a uint8 type; CreateImage with the film's size and channels R, G, B, then
+// UpdateImage (the form with channel offsets and strides) for the tiles whose pixels changed.
+// A viewer that is absent, refuses or goes away costs one warning line; the render goes on, and
+// the stream reconnects (and resends the whole image) when the viewer is back.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "nimbus/render/film.h"
+
+namespace nimbus {
+
+class DisplayServer {
+ public:
+  // `address` is HOST:PORT (std::invalid_argument otherwise); `name` is the image's name in the
+  // viewer; `warn` gets the one-line warnings. Connects lazily, on the first update.
+  DisplayServer(const std::string& address, std::string name,
+                std::function<void(const std::string&)> warn);
+  ~DisplayServer();
+  DisplayServer(const DisplayServer&) = delete;
+  DisplayServer& operator=(const DisplayServer&) = delete;
+
+  // Sends what changed in the film since the last update (all of it on a new connection): the
+  // pixels' means as the image written from the film has them (io/film_image.h).
+  void update(const Film& film);
+  // The last update, with the film written: as update, but a viewer that went away is tried
+  // again now rather than after the retry interval.
+  void finish(const Film& film);
+
+  // Tiles sent so far, for the tests and the benchmarks.
+  std::uint64_t tiles_sent() const { return tiles_sent_; }
+
+ private:
+  bool connect_once();
+  bool send_all(const std::vector<std::uint8_t>& packet);
+  void drop(const std::string& why);
+
+  std::string host_, port_, address_, name_;
+  std::function<void(const std::string&)> warn_;
+  int socket_ = -1;
+  bool warned_ = false;      // a warning was given since the last good connection
+  double next_attempt_ = 0;  // steady-clock seconds before which no reconnection is tried
+  std::vector<std::uint32_t> sent_samples_;  // per pixel, at the last update sent
+  std::uint64_t tiles_sent_ = 0;
+};
+
+// The pixel tiles of a stream: kDisplayTile × kDisplayTile pixels.
+inline constexpr int kDisplayTile = 64;
+
+}  // namespace nimbus
