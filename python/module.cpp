@@ -180,16 +180,20 @@ py::tuple render(const PyScene& scene, int spp, std::optional<uint64_t> seed, in
   return py::make_tuple(to_array(to_image(outcome.film)), job.stats(outcome).dump());
 }
 
-// The scene compiled for `seed` (its own when none), compiled once for the last seed asked.
+// The scene compiled for `seed` (its own when none), compiled once for the last seed asked. The
+// cache is read and written with the GIL held (other Python threads may render the same scene);
+// the compile itself runs without it.
 std::shared_ptr<const Scene> compiled_scene(const PyScene& scene, std::optional<uint64_t> seed) {
   auto& cache = *scene.compiled;
-  if (!cache.second || cache.first != seed) {
-    SceneDesc desc = reload(scene, seed);
+  if (cache.second && cache.first == seed) return cache.second;
+  const SceneDesc desc = reload(scene, seed);
+  std::shared_ptr<const Scene> compiled;
+  {
     py::gil_scoped_release release;
-    cache.second = std::make_shared<const Scene>(compile_scene(desc));
-    cache.first = seed;
+    compiled = std::make_shared<const Scene>(compile_scene(desc));
   }
-  return cache.second;
+  cache = {seed, compiled};
+  return compiled;
 }
 
 // A film of the scene's size and light scale (its exponent), for render_into.

@@ -357,3 +357,26 @@ def test_experiments_return_the_command_lines_csv_as_arrays(tmp_path):
     assert list(columns["channel"]) == [r["channel"] for r in rows]
     with pytest.raises(ValueError, match="unknown experiment \"nope\""):
         nimbus.experiment("nope")
+
+
+def test_threads_rendering_one_scene_with_other_seeds_get_their_own_bits():
+    scene = nimbus.load_file(DEMO, SMALL)
+    results, errors = {}, []
+
+    def work(seed):
+        try:
+            for _ in range(3):  # the scene's compiled cache changes seed under the other thread
+                film = nimbus.Film(scene)
+                nimbus.render_into(scene, film, samples=(0, 2), seed=seed, threads=1)
+            results[seed] = film.image()
+        except Exception as e:  # noqa: BLE001 (reported below)
+            errors.append(e)
+
+    threads = [threading.Thread(target=work, args=(seed,)) for seed in (11, 12)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors
+    for seed in (11, 12):
+        assert np.array_equal(results[seed], nimbus.render(scene, spp=2, seed=seed))
