@@ -1,5 +1,5 @@
-// The nimbus command line: `nimbus render SCENE ...`, `nimbus experiment NAME --out DIR` and
-// `nimbus export-vdb SCENE -o OUT.vdb --voxel-size H`.
+// The nimbus command line: `nimbus render SCENE ...`, `nimbus view SCENE`, `nimbus experiment
+// NAME --out DIR` and `nimbus export-vdb SCENE -o OUT.vdb --voxel-size H`.
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -40,6 +40,8 @@
 #include "nimbus/render/settings.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
+#include "nimbus/view/view_server.h"
+#include "nimbus/view/view_session.h"
 
 namespace {
 
@@ -405,6 +407,69 @@ int run_render(const RenderArgs& args, const Cluster& cluster) {
   return code;
 }
 
+struct ViewArgs {
+  std::string scene;
+  std::string host = "127.0.0.1";
+  int port = 8080;
+  std::vector<std::string> sets;
+  int spp = 0;
+  std::optional<uint64_t> seed;
+  int threads = 0;
+  std::optional<std::string> max_memory;
+};
+
+// `nimbus view`: the scene rendered progressively in a web page (view/view_server.h) until a
+// signal stops the server (exit 0).
+int run_view(const ViewArgs& args) {
+  using namespace nimbus;
+  ViewOptions options;
+  options.scene = args.scene;
+  options.overrides = args.sets;
+  options.spp = args.spp;
+  options.seed = args.seed;
+  options.threads = args.threads;
+  if (args.max_memory) {
+    try {
+      options.max_memory = parse_memory_size(*args.max_memory);
+    } catch (const std::invalid_argument& e) {
+      std::fprintf(stderr, "nimbus: --max-memory: %s\n", e.what());
+      return kExitBadInput;
+    }
+  }
+  ViewServerOptions server_options;
+  server_options.host = args.host;
+  server_options.port = args.port;
+  server_options.name = std::filesystem::path(args.scene).stem().string();
+  std::unique_ptr<ViewSession> session;
+  try {
+    session = std::make_unique<ViewSession>(options);
+  } catch (const std::exception& e) {
+    if (g_signal.load() != 0) return 0;
+    std::fprintf(stderr, "nimbus: %s\n", printable_line(e.what()).c_str());
+    return kExitBadInput;
+  }
+  ViewServer server(*session, server_options);
+  int port = 0;
+  try {
+    port = server.bind();
+  } catch (const std::runtime_error& e) {
+    std::fprintf(stderr, "nimbus: %s\n", printable_line(e.what()).c_str());
+    return kExitBadInput;
+  }
+  const bool v6 = args.host.find(':') != std::string::npos;
+  std::printf("nimbus view: http://%s%s%s:%d/ (Ctrl-C stops)\n", v6 ? "[" : "", args.host.c_str(),
+              v6 ? "]" : "", port);
+  std::fflush(stdout);
+  std::thread watcher([&server] {
+    while (g_signal.load() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    server.stop();
+  });
+  server.serve();
+  g_signal.store(g_signal.load() != 0 ? g_signal.load() : SIGTERM);  // ends the watcher
+  watcher.join();
+  return 0;
+}
+
 // nimbus's data (scenes/, tools/plot_*.py): share/nimbus beside the executable (the build tree
 // links it there) or above it (an installed prefix: bin/nimbus, share/nimbus).
 std::filesystem::path data_dir() {
@@ -695,6 +760,25 @@ int run_command(int argc, char** argv, const Cluster& cluster) {
                      "was started with); later checkpoints go to the same file unless "
                      "--checkpoint says otherwise");
 
+  ViewArgs view_args;
+  CLI::App* view = app.add_subcommand(
+      "view", "Render a scene progressively in a web page, with camera moves and live reloads");
+  view->add_option("scene", view_args.scene, "Scene file (JSON), rendered again when saved")
+      ->required();
+  view->add_option("--port", view_args.port, "Port to serve on (0: any free port; default 8080)")
+      ->check(integer_in(0, 65535));
+  view->add_option("--host", view_args.host,
+                   "Address to serve on (default 127.0.0.1: this machine only)");
+  view->add_option("--spp", view_args.spp, "Samples per pixel to refine to (default: the scene's)")
+      ->check(integer_in(1));
+  view->add_option("--seed", view_args.seed, "Random seed (overrides integrator.seed)")
+      ->check(unsigned_64());
+  view->add_option("--threads", view_args.threads, "Worker threads (default: all cores)")
+      ->check(integer_in(1, 4096));
+  view->add_option("--set", view_args.sets, "Override a scene key, as for render; repeatable");
+  view->add_option("--max-memory", view_args.max_memory,
+                   "Refuse scenes estimated to need more memory than this (as for render)");
+
   ExperimentArgs exp;
   std::string names;
   for (const auto& e : nimbus::experiments()) names += "\n  " + e.name + ": " + e.description;
@@ -756,6 +840,7 @@ int run_command(int argc, char** argv, const Cluster& cluster) {
     if (settings->parsed()) return list_settings(markdown_section);
     catch_stop_signals();
     if (export_vdb->parsed()) return run_export_vdb(exp_vdb);
+    if (view->parsed()) return run_view(view_args);
     return run_render(args, cluster);
   } catch (const std::bad_alloc&) {
     // Past the estimate (render/memory_estimate.h), e.g. a --max-memory above what the machine

@@ -6,7 +6,7 @@
 set -euo pipefail
 src="${1:-$(dirname "$0")/../src/nimbus}"
 declare -A rank=([math]=0 [frep]=1 [spectral]=1 [media]=2 [tracking]=3 [render]=4 [scene]=5
-                 [io]=6 [job]=7 [experiments]=7)
+                 [io]=6 [job]=7 [experiments]=7 [view]=8)
 bad=0
 for module in "${!rank[@]}"; do
   [ -d "$src/$module" ] || { echo "check_layers: no module $module in $src" >&2; exit 1; }

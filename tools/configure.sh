@@ -13,7 +13,8 @@ kind=${1:?"usage: tools/configure.sh release|sanitize [DIR] [CMAKE ARGS...]"}
 case $kind in
   release)
     dir=${2:-build}
-    # Debian's interpreter, which has python3-numpy, for the Python module (docs/python.md).
+    # Debian's interpreter, which has python3-numpy and pytest, for the Python module
+    # (docs/python.md) and the viewer's browser tests (both builds).
     args=(-DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=/usr/bin/python3)
     ;;
   sanitize)
@@ -24,7 +25,7 @@ case $kind in
     args=(-DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo
       "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -gline-tables-only -DNDEBUG"
       -DNIMBUS_SANITIZE=ON -DNIMBUS_BUILD_FUZZER=ON -DNIMBUS_BUILD_BENCH=OFF
-      "-DNIMBUS_WAVELENGTH_COUNTS=4;8")
+      "-DNIMBUS_WAVELENGTH_COUNTS=4;8" -DPython3_EXECUTABLE=/usr/bin/python3)
     ;;
   *)
     echo "tools/configure.sh: unknown build \"$kind\" (release or sanitize)" >&2

@@ -16,4 +16,8 @@ uint8_t encode_srgb8(float linear);
 // std::runtime_error("PATH: problem").
 void write_png(const std::string& path, const Image& image);
 
+// The same image as the bytes of a PNG file (what write_png writes), for serving. Throws
+// std::runtime_error("libpng: problem").
+std::string encode_png(const Image& image);
+
 }  // namespace nimbus

@@ -18,13 +18,14 @@
 #include "nimbus/spectral/wavelengths.h"
 
 namespace nimbus {
-namespace {
 
 Camera compile_camera(const CameraDesc& c, const RenderSettings& film) {
   if (c.type == CameraDesc::Type::Orthographic)
     return orthographic_camera(c.from, c.to, c.up, c.width, film.width, film.height);
   return perspective_camera(c.from, c.to, c.up, c.fov, film.width, film.height);
 }
+
+namespace {
 
 Surface compile_surface(const SurfaceDesc& d) {
   Surface s;
@@ -157,7 +158,7 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
   if (watch.cancelled()) return scene;  // not to be rendered
   watch.report(1);
   unplaced.clear();
-  std::vector<double> field_g;  // the different anisotropies of index-matched media
+  std::vector<double> field_g;    // the different anisotropies of index-matched media
   scene.objects.reserve(copies);  // growing it would hold two copies of 10^6 objects at once
   for (std::size_t k = 0; k < desc.objects.size(); ++k) {
     const ObjectDesc& od = desc.objects[k];

@@ -29,6 +29,8 @@ inline constexpr double kMaxOpticalThickness = 1e6;
 Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor = {},
                     std::vector<InputFile>* inputs = nullptr);
 
+// The run-time camera of a description's camera for the film's size.
+Camera compile_camera(const CameraDesc& camera, const RenderSettings& film);
 // The medium an object of the description holds once compiled: its own, or -1 where an opaque
 // surface (diffuse, emissive) hides it; only solids and index-matched objects hold one.
 int compiled_medium(const ObjectDesc& object);

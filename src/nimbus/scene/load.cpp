@@ -184,6 +184,13 @@ class Loader {
     return scene;
   }
 
+  // A document {"camera": CAMERA}: the camera, checked as a scene file's (load_camera_json).
+  CameraDesc load_camera() {
+    const JsonValue value = root_.required("camera");
+    root_.finish();
+    return read_camera(value);
+  }
+
   // A document {"shape": SHAPE, "shapes": {NAME: SHAPE, ...}}: the shape, its names resolved in
   // the table (load_shape_json).
   ShapePtr load_shape() {
@@ -782,6 +789,11 @@ ShapePtr load_shape_json(const nlohmann::json& shape, const nlohmann::json& shap
   if (!shapes.is_null()) document["shapes"] = shapes;
   const JsonOrigin origin{source, {}, ""};
   return Loader(JsonValue(document, "", origin)).load_shape();
+}
+
+CameraDesc load_camera_json(const nlohmann::json& camera, const std::string& source) {
+  const nlohmann::json document = {{"camera", camera}};
+  return Loader(JsonValue(document, "", JsonOrigin{source, {}, ""})).load_camera();
 }
 
 SceneDesc load_scene_json(nlohmann::json j, const std::string& source,

@@ -70,6 +70,10 @@ SceneDesc load_scene_json(nlohmann::json j, const std::string& source,
 ShapePtr load_shape_json(const nlohmann::json& shape, const nlohmann::json& shapes,
                          const std::string& source);
 
+// A "camera" value on its own (nimbus view's camera moves), checked as in a scene file; messages
+// read "SOURCE: /camera/...: problem".
+CameraDesc load_camera_json(const nlohmann::json& camera, const std::string& source);
+
 // A "transform" value (docs/scene-format.md): steps applied in the listed order; a degenerate one
 // fails. Shapes and the "vdb" density read it.
 Mat4 read_transform(const JsonValue& v);

@@ -1,0 +1,118 @@
+#include "nimbus/view/preview.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "nimbus/math/box.h"
+#include "nimbus/media/medium_field.h"
+
+namespace nimbus {
+namespace {
+
+// What the eye sees at a surface: its colour under a light at the eye, with a floor so that
+// grazing faces stay visible. Dielectrics holding a medium show the medium's single-scattering
+// albedo, the colour they take on once light has wandered inside.
+Rgb surface_colour(const Scene& scene, const SceneObject& object, double cos_eye) {
+  const double shade = 0.2 + 0.8 * std::abs(cos_eye);
+  switch (object.surface.type) {
+    case Surface::Type::Emissive:
+      return object.surface.radiance.rgb;
+    case Surface::Type::Diffuse:
+      return object.surface.albedo.rgb * shade;
+    case Surface::Type::Dielectric: {
+      if (object.medium < 0) return Rgb(0.9) * shade;
+      const Medium& m = scene.media[size_t(object.medium)];
+      const Rgb mu_t = m.sigma_a.rgb + m.sigma_s.rgb;
+      Rgb albedo(0.0);
+      for (int c = 0; c < 3; ++c) albedo[c] = mu_t[c] > 0 ? m.sigma_s.rgb[c] / mu_t[c] : 0.0;
+      return albedo * shade;
+    }
+    case Surface::Type::None:
+      break;
+  }
+  return Rgb(0.0);
+}
+
+// Radiance of what a ray that leaves the scene meets: the environment lights.
+Rgb background(const Scene& scene) {
+  Rgb L(0.0);
+  for (const int i : scene.lights_at_infinity)
+    if (scene.lights[size_t(i)].type == Light::Type::Environment)
+      L += scene.lights[size_t(i)].emission.rgb;
+  return L;
+}
+
+Box field_bounds(const Scene& scene) {
+  Box b;
+  for (const int i : scene.field_objects) b = unite(b, scene.objects[size_t(i)].bounds);
+  return b;
+}
+
+}  // namespace
+
+int preview_downscale(int width, int height, int pixels) {
+  int d = 1;
+  while (double(width) * height > double(pixels) * d * d) ++d;
+  return d;
+}
+
+Image render_preview(const Scene& scene, const PreviewOptions& options) {
+  const int d = std::max(1, options.downscale);
+  const int w = (scene.camera.width + d - 1) / d, h = (scene.camera.height + d - 1) / d;
+  Image image{w, h, std::vector<float>(size_t(w) * h * 3)};
+  const Rgb sky = background(scene);
+  const Box media = field_bounds(scene);
+  const int steps = std::max(1, options.steps);
+  tbb::parallel_for(0, h, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      const double fx = std::min((x + 0.5) * d, double(scene.camera.width));
+      const double fy = std::min((y + 0.5) * d, double(scene.camera.height));
+      const Ray ray = scene.camera.generate(fx, fy);
+      const auto hit = intersect(scene, ray, Box::kInf);
+      Rgb L = sky;
+      double t_end = Box::kInf;
+      if (hit) {
+        t_end = hit->t;
+        if (hit->light >= 0) {
+          L = scene.lights[size_t(hit->light)].emission.rgb;
+        } else {
+          const SceneObject& object = scene.objects[size_t(hit->object)];
+          const Vec3 n = outward_normal(object, ray.at(hit->t));
+          L = surface_colour(scene, object, dot(n, ray.d));
+        }
+      }
+      // The media in front of it, marched at the steps' midpoints: transmittance T, and per
+      // step mu_a L_e plus mu_s times a unit light from everywhere (eq. 4 without shadows).
+      double t0 = 0, t1 = t_end;
+      if (!media.empty() && clip_ray(media, ray, t0, t1) && t1 > t0) {
+        const double dt = (t1 - t0) / steps;
+        Rgb T(1.0), in(0.0);
+        for (int i = 0; i < steps; ++i) {
+          const Vec3 p = ray.at(t0 + (i + 0.5) * dt);
+          Rgb mu_a(0.0), mu_s(0.0), emitted(0.0);
+          for_each_medium_at(scene, p, -1, [&](int m, double density) {
+            const Medium& medium = scene.media[size_t(m)];
+            mu_a += medium.sigma_a.rgb * density;
+            mu_s += medium.sigma_s.rgb * density;
+            emitted += medium.sigma_a.rgb * medium.emission.rgb * density;
+          });
+          Rgb step_T(0.0);
+          for (int c = 0; c < 3; ++c) step_T[c] = std::exp(-(mu_a[c] + mu_s[c]) * dt);
+          // The step's own source, as if spread evenly over it: (1 - T_step) / mu_t.
+          for (int c = 0; c < 3; ++c) {
+            const double mu_t = mu_a[c] + mu_s[c];
+            if (mu_t > 0) in[c] += T[c] * (1 - step_T[c]) * (emitted[c] + mu_s[c]) / mu_t;
+          }
+          T = T * step_T;
+        }
+        L = L * T + in;
+      }
+      for (int c = 0; c < 3; ++c) image.rgb[3 * (size_t(y) * w + x) + c] = float(L[c]);
+    }
+  });
+  return image;
+}
+
+}  // namespace nimbus

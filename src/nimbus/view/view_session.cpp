@@ -1,0 +1,237 @@
+#include "nimbus/view/view_session.h"
+
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <system_error>
+
+#include "nimbus/io/film_image.h"
+#include "nimbus/job/render_job.h"
+#include "nimbus/render/renderer.h"
+#include "nimbus/scene/compile.h"
+#include "nimbus/scene/load.h"
+#include "nimbus/view/preview.h"
+
+namespace nimbus {
+namespace {
+
+bool same_camera(const CameraDesc& a, const CameraDesc& b) {
+  return a.type == b.type && a.from == b.from && a.to == b.to && a.up == b.up && a.fov == b.fov &&
+         a.width == b.width;
+}
+
+// A pass aims at this long: short enough to follow a camera move at once, long enough that the
+// image is not copied out more often than a page can show it.
+constexpr double kPassSeconds = 0.3;
+
+}  // namespace
+
+double view_noise(const Film& film) {
+  const auto luminance = [](const Rgb& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; };
+  double var = 0, mean = 0;
+  for (int p = 0; p < film.pixels(); ++p) {
+    if (film.samples[size_t(p)] < 2) return 0;
+    var += std::abs(luminance(film.variance_of_mean(p)));
+    mean += luminance(film.mean(p));
+  }
+  return mean > 0 ? std::sqrt(var / film.pixels()) / (mean / film.pixels()) : 0;
+}
+
+ViewSession::ViewSession(ViewOptions options) : options_(std::move(options)) {
+  if (!load()) throw SceneError(frame_.error);
+  thread_ = std::thread([this] { loop(); });
+}
+
+ViewSession::~ViewSession() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  interrupt_ = true;
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+ViewFrame ViewSession::frame() const {
+  std::lock_guard lock(mutex_);
+  return frame_;
+}
+
+void ViewSession::set_camera(const CameraDesc& camera) {
+  {
+    std::lock_guard lock(mutex_);
+    pending_camera_ = camera;
+    interrupt_ = true;
+  }
+  wake_.notify_all();
+}
+
+bool ViewSession::wait(const std::function<bool(const ViewFrame&)>& until,
+                       double timeout_seconds) const {
+  std::unique_lock lock(mutex_);
+  return changed_.wait_for(lock, std::chrono::duration<double>(timeout_seconds),
+                           [&] { return until(frame_); });
+}
+
+ViewSession::Stamp ViewSession::stamp(const std::string& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::is_regular_file(status)) return {path, 0, -1};
+  const auto mtime = std::filesystem::last_write_time(path, ec);
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec) return {path, 0, -1};
+  return {path, int64_t(mtime.time_since_epoch().count()), int64_t(size)};
+}
+
+bool ViewSession::files_changed() const {
+  return std::any_of(watched_.begin(), watched_.end(),
+                     [](const Stamp& s) { return stamp(s.path) != s; });
+}
+
+bool ViewSession::load() {
+  // What is watched is stamped before it is read: an edit made while it loads is seen next time.
+  std::vector<Stamp> watched{stamp(options_.scene)};
+  for (size_t i = 1; i < watched_.size(); ++i) watched.push_back(stamp(watched_[i].path));
+  try {
+    std::vector<std::string> overrides = options_.overrides;
+    if (options_.seed) overrides.push_back("integrator.seed=" + std::to_string(*options_.seed));
+    SceneDesc desc = load_scene_file(options_.scene, overrides);
+    if (options_.spp > 0) desc.settings.spp = options_.spp;
+    check_render_memory(desc, options_.threads, options_.max_memory);
+    std::vector<InputFile> inputs;
+    watched.resize(1);
+    for (const InputFile& f : desc.inputs) watched.push_back(stamp(f.path));
+    BuildMonitor monitor;
+    monitor.cancel = [this] {
+      std::lock_guard lock(mutex_);
+      return stop_;
+    };
+    auto scene = std::make_unique<Scene>(compile_scene(desc, monitor, &inputs));
+    for (const InputFile& f : inputs) watched.push_back(stamp(f.path));
+    watched_ = std::move(watched);
+    if (monitor.cancel()) return false;
+    // The page's camera stays unless the file's camera, or the film's size, changed.
+    const bool resized = !scene_ || scene_->settings.width != scene->settings.width ||
+                         scene_->settings.height != scene->settings.height;
+    if (!scene_ || resized || !same_camera(desc.camera, file_camera_)) camera_ = desc.camera;
+    file_camera_ = desc.camera;
+    scene->camera = compile_camera(camera_, scene->settings);
+    scene_ = std::move(scene);
+    std::lock_guard lock(mutex_);
+    frame_.error.clear();
+    ++frame_.loads;
+  } catch (const std::exception& e) {
+    watched_ = std::move(watched);
+    std::lock_guard lock(mutex_);
+    frame_.error = printable_line(e.what());
+    ++frame_.version;  // the page learns of the error as of an image
+    changed_.notify_all();
+    return false;
+  }
+  restart(Clock::now());
+  return true;
+}
+
+void ViewSession::restart(Clock::time_point now) {
+  film_ = make_film(*scene_);
+  spp_ = 0;
+  pass_spp_ = 1;
+  samples_ = 0;
+  render_seconds_ = 0;
+  restarted_ = now;
+  need_preview_ = true;
+  std::lock_guard lock(mutex_);
+  frame_.film_image.reset();
+  frame_.width = film_.width;
+  frame_.height = film_.height;
+  frame_.spp = 0;
+  frame_.target_spp = scene_->settings.spp;
+  frame_.samples_per_second = 0;
+  frame_.noise = 0;
+  frame_.camera = camera_;
+  ++frame_.restarts;
+}
+
+void ViewSession::publish(std::shared_ptr<const Image> image, bool preview) {
+  const double elapsed = std::chrono::duration<double>(Clock::now() - restarted_).count();
+  const double noise = preview ? 0 : view_noise(film_);
+  std::lock_guard lock(mutex_);
+  ++frame_.version;
+  frame_.image = std::move(image);
+  frame_.preview = preview;
+  if (!preview) frame_.film_image = frame_.image;
+  frame_.spp = spp_;
+  frame_.elapsed = elapsed;
+  frame_.samples_per_second = render_seconds_ > 0 ? double(samples_) / render_seconds_ : 0;
+  frame_.noise = noise;
+  changed_.notify_all();
+}
+
+void ViewSession::render_preview_frame() {
+  PreviewOptions po;
+  po.downscale = preview_downscale(film_.width, film_.height, options_.preview_pixels);
+  tbb::task_arena arena(options_.threads > 0 ? options_.threads : tbb::task_arena::automatic);
+  auto image = std::make_shared<Image>(arena.execute([&] { return render_preview(*scene_, po); }));
+  need_preview_ = false;
+  publish(std::move(image), true);
+}
+
+void ViewSession::render_pass() {
+  RenderOptions ro;
+  ro.threads = options_.threads;
+  ro.range.s0 = spp_;
+  ro.range.s1 = std::min(scene_->settings.spp, spp_ + pass_spp_);
+  ro.cancel = [this] { return interrupt_.load(std::memory_order_relaxed); };
+  const RenderStats stats = render_into(*scene_, film_, ro);
+  // A cancelled pass leaves pixels at two sample counts: start again.
+  if (stats.cancelled) return restart(Clock::now());
+  const int done = ro.range.s1 - ro.range.s0;
+  spp_ = ro.range.s1;
+  samples_ += uint64_t(done) * uint64_t(film_.pixels());
+  render_seconds_ += stats.seconds;
+  pass_spp_ =
+      std::clamp(int(pass_spp_ * kPassSeconds / std::max(stats.seconds, 1e-3)), 1, 2 * pass_spp_);
+  publish(std::make_shared<Image>(to_image(film_)), false);
+}
+
+void ViewSession::loop() {
+  auto next_watch = Clock::now();
+  for (;;) {
+    std::optional<CameraDesc> camera;
+    {
+      std::lock_guard lock(mutex_);
+      if (stop_) return;
+      camera.swap(pending_camera_);
+      interrupt_ = false;
+    }
+    const auto now = Clock::now();
+    if (now >= next_watch) {
+      next_watch = now + std::chrono::duration_cast<Clock::duration>(
+                             std::chrono::duration<double>(options_.watch_interval));
+      if (files_changed()) load();
+    }
+    if (camera) {
+      camera_ = *camera;
+      scene_->camera = compile_camera(camera_, scene_->settings);
+      moved_ = now;
+      restart(now);
+    }
+    if (need_preview_) {
+      render_preview_frame();
+      continue;
+    }
+    const auto rested = moved_ + std::chrono::duration_cast<Clock::duration>(
+                                     std::chrono::duration<double>(options_.rest));
+    if (now >= rested && spp_ < scene_->settings.spp) {
+      render_pass();
+      continue;
+    }
+    std::unique_lock lock(mutex_);
+    wake_.wait_until(lock, now < rested ? std::min(rested, next_watch) : next_watch,
+                     [&] { return stop_ || pending_camera_.has_value(); });
+  }
+}
+
+}  // namespace nimbus

@@ -1,0 +1,232 @@
+// nimbus view's parts below the web server (issue 28): the preview against closed forms, the
+// session's film against render()'s bits after a camera move, reloads and a broken file keeping
+// the last image, the noise figure, PNG bytes in memory, and the camera's messages.
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "nimbus/io/film_image.h"
+#include "nimbus/io/png.h"
+#include "nimbus/render/renderer.h"
+#include "nimbus/scene/compile.h"
+#include "nimbus/scene/json_reader.h"
+#include "nimbus/scene/load.h"
+#include "nimbus/view/preview.h"
+#include "nimbus/view/view_session.h"
+#include "support/process.h"
+
+namespace nimbus {
+namespace view_test {
+
+namespace fs = std::filesystem;
+
+std::string scene_text(const std::string& albedo) {
+  return fmt::format(R"({{
+  "film": {{"width": 16, "height": 12}},
+  "camera": {{"type": "perspective", "from": [0, 1, 6], "to": [0, 0, 0], "fov": 35}},
+  "integrator": {{"spp": 6, "seed": 3}},
+  "lights": [{{"type": "environment", "radiance": [0.8, 0.9, 1.0]}}],
+  "objects": [{{"shape": {{"type": "sphere", "center": [0, 0, 0], "radius": 1.2}},
+                "surface": {{"type": "diffuse", "albedo": {}}}}}]
+}})",
+                     albedo);
+}
+
+// A film's image rendered by render() at the scene's spp, with overrides.
+Image reference(const std::string& scene, const std::vector<std::string>& overrides) {
+  RenderOptions o;
+  o.threads = 2;
+  return to_image(render(compile_scene(load_scene_file(scene, overrides)), o).film);
+}
+
+bool same_camera(const CameraDesc& a, const CameraDesc& b) {
+  return a.from == b.from && a.to == b.to && a.up == b.up && a.fov == b.fov;
+}
+
+class Session : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::fresh_test_dir("nimbus_view");
+    scene_ = (dir_ / "scene.json").string();
+    write(scene_text("[0.8, 0.3, 0.2]"));
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  void write(const std::string& text) const {
+    // Written beside and renamed, as editors save: the session never reads half a file.
+    const std::string temp = scene_ + ".tmp";
+    std::ofstream(temp) << text;
+    fs::rename(temp, scene_);
+  }
+  ViewOptions options() const {
+    ViewOptions o;
+    o.scene = scene_;
+    o.threads = 2;
+    o.rest = 0;
+    o.watch_interval = 0.02;
+    return o;
+  }
+  fs::path dir_;
+  std::string scene_;
+};
+
+auto done = [](const ViewFrame& f) { return !f.preview && f.spp == f.target_spp; };
+
+TEST_F(Session, RefinesToTheBitsOfRenderThenFollowsTheCamera) {
+  ViewSession session(options());
+  ASSERT_TRUE(session.wait(done, 60));
+  ViewFrame f = session.frame();
+  EXPECT_EQ(f.spp, 6);
+  EXPECT_EQ(f.loads, 1u);
+  EXPECT_EQ(f.film_image->rgb, reference(scene_, {}).rgb);
+  EXPECT_GT(f.samples_per_second, 0);
+  EXPECT_GT(f.noise, 0);
+
+  CameraDesc moved = f.camera;
+  moved.from = {2, 1.5, 5};
+  session.set_camera(moved);
+  ASSERT_TRUE(session.wait(
+      [&](const ViewFrame& g) { return same_camera(g.camera, moved) && done(g); }, 60));
+  f = session.frame();
+  EXPECT_EQ(f.film_image->rgb, reference(scene_, {"camera.from=[2, 1.5, 5]"}).rgb);
+}
+
+TEST_F(Session, ShowsAPreviewWhileTheCameraMoves) {
+  ViewOptions o = options();
+  o.rest = 30;  // the camera never rests in this test
+  ViewSession session(o);
+  CameraDesc moved = session.frame().camera;
+  moved.fov = 50;
+  session.set_camera(moved);
+  ASSERT_TRUE(session.wait(
+      [&](const ViewFrame& g) { return same_camera(g.camera, moved) && g.preview && g.image; },
+      60));
+  const ViewFrame f = session.frame();
+  EXPECT_EQ(f.spp, 0);
+  EXPECT_EQ(f.film_image, nullptr);
+}
+
+TEST_F(Session, ReloadsASavedFileAndKeepsTheLastImageOfABrokenOne) {
+  ViewSession session(options());
+  ASSERT_TRUE(session.wait(done, 60));
+  write(scene_text("[0.2, 0.3, 0.9]") + "\n");
+  ASSERT_TRUE(session.wait([](const ViewFrame& g) { return g.loads == 2 && done(g); }, 60));
+  ViewFrame f = session.frame();
+  EXPECT_EQ(f.film_image->rgb, reference(scene_, {}).rgb);
+
+  const std::shared_ptr<const Image> last = f.image;
+  write(R"({"camera": {"from": [0, 1, 6], "to": [0, 0, 0], "fvo": 35}})");
+  ASSERT_TRUE(session.wait([](const ViewFrame& g) { return !g.error.empty(); }, 60));
+  f = session.frame();
+  EXPECT_EQ(f.error, scene_ + ": /camera/fvo: unknown key (did you mean \"fov\"?)");
+  EXPECT_EQ(f.image, last);
+  EXPECT_EQ(f.loads, 2u);
+
+  write(scene_text("[0.5, 0.5, 0.5]"));
+  ASSERT_TRUE(session.wait([](const ViewFrame& g) { return g.loads == 3 && done(g); }, 60));
+  EXPECT_EQ(session.frame().error, "");
+}
+
+TEST_F(Session, ABrokenFileAtTheStartIsTheLoadersError) {
+  write("{\"camera\": ");
+  try {
+    ViewSession session(options());
+    FAIL() << "a broken file loaded";
+  } catch (const SceneError& e) {
+    EXPECT_TRUE(std::string(e.what()).starts_with(scene_ + ": ")) << e.what();
+  }
+}
+
+TEST(ViewNoise, IsTheRelativeRmsStandardErrorOfLuminance) {
+  Film film(2, 1);
+  for (double v : {1.0, 3.0}) film.add(0, Rgb(v));       // mean 2, variance of mean 1
+  for (double v : {2.0, 2.0, 2.0}) film.add(1, Rgb(v));  // mean 2, variance 0
+  EXPECT_NEAR(view_noise(film), std::sqrt(0.5) / 2, 1e-12);
+  Film sparse(1, 1);
+  sparse.add(0, Rgb(1.0));
+  EXPECT_EQ(view_noise(sparse), 0);
+}
+
+TEST(Preview, ASlabOfMediumIsItsClosedForm) {
+  // An orthographic view through 2 units of a constant medium under a uniform sky E: every pixel
+  // sees L = E T + (1 - T) mu_s / mu_t with T = exp(-2 mu_t) (a unit light scattered, no shadows).
+  const std::string text = R"({
+    "film": {"width": 4, "height": 4},
+    "camera": {"type": "orthographic", "from": [0, 0, 5], "to": [0, 0, 0], "width": 1},
+    "lights": [{"type": "environment", "radiance": 0.5}],
+    "media": {"m": {"sigma_a": [0.1, 0.2, 0.3], "sigma_s": [0.4, 0.6, 0.8], "density": {"type": "constant"}}},
+    "objects": [{"shape": {"type": "box", "min": [-3, -3, -1], "max": [3, 3, 1]}, "medium": "m",
+                 "surface": {"type": "none"}}]
+  })";
+  const Scene scene = compile_scene(load_scene_text(text, "slab"));
+  PreviewOptions o;
+  o.steps = 4096;
+  const Image image = render_preview(scene, o);
+  ASSERT_EQ(image.width, 4);
+  const double mu_a[3] = {0.1, 0.2, 0.3}, mu_s[3] = {0.4, 0.6, 0.8};
+  for (int p = 0; p < 16; ++p)
+    for (int c = 0; c < 3; ++c) {
+      const double mu_t = mu_a[c] + mu_s[c], T = std::exp(-2 * mu_t);
+      // The bounds may exceed the box by a little: one step's optical depth at each end.
+      EXPECT_NEAR(image.rgb[3 * size_t(p) + c], 0.5 * T + (1 - T) * mu_s[c] / mu_t, 2e-3)
+          << "pixel " << p << " channel " << c;
+    }
+}
+
+TEST(Preview, ADiffuseSurfaceFacingTheEyeShowsItsAlbedo) {
+  const std::string text = R"({
+    "film": {"width": 9, "height": 9},
+    "camera": {"type": "perspective", "from": [0, 0, 6], "to": [0, 0, 0], "fov": 30},
+    "lights": [{"type": "environment", "radiance": 0.25}],
+    "objects": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1},
+                 "surface": {"type": "diffuse", "albedo": [0.7, 0.5, 0.3]}}]
+  })";
+  const Image image = render_preview(compile_scene(load_scene_text(text, "ball")));
+  const size_t centre = 3 * (4 * 9 + 4), corner = 0;
+  EXPECT_NEAR(image.rgb[centre + 0], 0.7, 1e-6);
+  EXPECT_NEAR(image.rgb[centre + 2], 0.3, 1e-6);
+  EXPECT_FLOAT_EQ(image.rgb[corner], 0.25f);  // the sky
+  EXPECT_EQ(preview_downscale(1920, 1080, 1 << 16), 6);
+  EXPECT_EQ(preview_downscale(160, 120, 1 << 16), 1);
+}
+
+TEST(EncodePng, IsTheBytesWritePngWrites) {
+  Image image{
+      3, 2, {0, 0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f, 0.7f, 0.8f, 0.9f, 1, 2, 0, 0, 0, 1, 1, 1}};
+  const fs::path dir = test::fresh_test_dir("nimbus_png");
+  const std::string path = (dir / "a.png").string();
+  write_png(path, image);
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  EXPECT_EQ(encode_png(image), bytes.str());
+  fs::remove_all(dir);
+  EXPECT_THROW(encode_png(Image{2, 2, {0}}), std::runtime_error);
+}
+
+TEST(LoadCameraJson, ChecksAsTheSceneFileDoes) {
+  const CameraDesc c =
+      load_camera_json(nlohmann::json::parse(R"({"from": [1, 2, 3], "to": [0, 0, 0]})"), "camera");
+  EXPECT_EQ(c.from, Vec3(1, 2, 3));
+  EXPECT_EQ(c.fov, 40);
+  auto message = [](const char* json) {
+    try {
+      load_camera_json(nlohmann::json::parse(json), "camera");
+    } catch (const SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message(R"({"from": [0, 0, 1], "to": [0, 0, 1]})"),
+            R"(camera: /camera/to: must differ from "from")");
+  EXPECT_EQ(message(R"({"from": [0, 0, 1], "to": [0, 0, 0], "fov": 180})"),
+            "camera: /camera/fov: must be in (0, 180)");
+  EXPECT_EQ(message(R"([1, 2])"), "camera: /camera: expected an object, not an array");
+}
+
+}  // namespace view_test
+}  // namespace nimbus
