@@ -211,7 +211,7 @@ TEST(EncodePng, IsTheBytesWritePngWrites) {
 TEST(LoadCameraJson, ChecksAsTheSceneFileDoes) {
   const CameraDesc c =
       load_camera_json(nlohmann::json::parse(R"({"from": [1, 2, 3], "to": [0, 0, 0]})"), "camera");
-  EXPECT_EQ(c.from, Vec3(1, 2, 3));
+  EXPECT_EQ(c.from, (Vec3{1, 2, 3}));
   EXPECT_EQ(c.fov, 40);
   auto message = [](const char* json) {
     try {
