@@ -52,8 +52,9 @@ struct RenderJobOptions {
   std::function<void(double)> progress;  // the fraction done, now and then
   std::function<bool()> cancel;          // polled; true stops the job
   std::function<void(const std::string&)> warning;  // a problem the job survives, one line
-  // Called a few times a second and at the end with the film so far (complete work units), on
-  // the lead: --display-server (io/display_server.h). Set, the job renders in units.
+  // Called a few times a second with the film so far, on the lead: --display-server
+  // (io/display_server.h). Set, the job renders in passes of samples over the whole film (in
+  // units with checkpoints or processes); the caller shows the outcome's film at the end.
   std::function<void(const Film&)> display;
 };
 
@@ -121,6 +122,7 @@ class RenderJob {
 
  private:
   JobOutcome run_at_once();
+  JobOutcome run_in_passes();
   JobOutcome run_shared(JobChannel* channel);
 
   RenderJobOptions options_;
