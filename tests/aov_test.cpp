@@ -2,7 +2,7 @@
 // analytic scenes (exactly where every sample sees the same thing, within the binomial or
 // exponential standard error where a path's choice decides); the variance layer; colour that
 // does not change by a bit when AOVs are recorded; layers that are the same bits for any split
-// of the work; films, patches and EXRs that carry them.
+// of the work; films, patches and EXRs that carry them; the command line's --aov.
 
 #include <gtest/gtest.h>
 
@@ -344,6 +344,112 @@ TEST(AovFilm, FilmFilesPatchesAndExrsCarryTheLayers) {
     EXPECT_EQ(it->values, written.values) << written.name;
   }
   fs::remove_all(dir);
+}
+
+// The command line: --aov and film.aov, their errors, and a checkpointed render.
+constexpr const char* kScene = R"({
+  "film": {"width": 12, "height": 8},
+  "camera": {"type": "perspective", "from": [0, 1, 6], "to": [0, 0, 0], "fov": 35},
+  "integrator": {"spp": 4, "seed": 7},
+  "lights": [{"type": "environment", "radiance": [0.8, 0.9, 1.0]}],
+  "media": {"fog": {"sigma_a": 0.2, "sigma_s": [3, 4, 5]}},
+  "objects": [
+    {"shape": {"type": "sphere", "center": [-1, 0, 0], "radius": 0.8}, "medium": "fog"},
+    {"shape": {"type": "sphere", "center": [1, 0, 0], "radius": 0.8},
+     "surface": {"type": "dielectric", "ior": 1.5}},
+    {"shape": {"type": "box", "min": [-5, -1.6, -5], "max": [5, -1.5, 5]},
+     "surface": {"type": "diffuse", "albedo": [0.7, 0.5, 0.3]}}
+  ]
+})";
+
+class AovCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::fresh_test_dir("nimbus_aovcli");
+    std::ofstream(dir_ / "scene.json") << kScene;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  test::Ran run(const std::string& args) { return test::run_nimbus_in(dir_, args); }
+  void expect_refused(const std::string& args, const std::string& line) {
+    const test::Ran r = run(args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(r.err, line + "\n") << args;
+    for (const auto& e : fs::directory_iterator(dir_))
+      EXPECT_EQ(e.path().filename(), "scene.json") << "nothing written: " << args;
+  }
+  std::vector<std::string> layer_names(const std::string& exr) {
+    std::vector<std::string> names;
+    for (const ImageLayer& l : read_exr((dir_ / exr).string()).layers) names.push_back(l.name);
+    return names;
+  }
+  fs::path dir_;
+};
+
+TEST_F(AovCli, RefusesUnknownAndRepeatedNamesAndPngOutputs) {
+  expect_refused("render scene.json -o a.exr --aov albedo,nromal",
+                 "nimbus: --aov: unknown AOV \"nromal\" (one of: albedo, normal, depth, variance)");
+  expect_refused("render scene.json -o a.exr --aov depth,depth",
+                 "nimbus: --aov: names \"depth\" twice");
+  expect_refused("render scene.json -o a.exr -o a.png --aov albedo",
+                 "nimbus: -o a.png: AOVs (--aov, film.aov) are layers of an EXR; write the render "
+                 "to an .exr");
+  expect_refused("render scene.json -o a.png --set 'film.aov=[\"normal\"]'",
+                 "nimbus: -o a.png: AOVs (--aov, film.aov) are layers of an EXR; write the render "
+                 "to an .exr");
+  expect_refused("render scene.json -o a.exr --set 'film.aov=[\"albedo\", \"Depth\"]'",
+                 "--set film.aov=[\"albedo\", \"Depth\"]: /film/aov/1: unknown AOV \"Depth\" "
+                 "(expected one of: albedo, normal, depth, variance)");
+}
+
+TEST_F(AovCli, WritesTheLayersIntoTheExrAlone) {
+  const test::Ran r = run("render scene.json -q --aov normal,albedo,variance,depth");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "scene.exr"));
+  EXPECT_FALSE(fs::exists(dir_ / "scene.png")) << "the default outputs are the EXR alone";
+  // OpenEXR lists channels by name.
+  EXPECT_EQ(layer_names("scene.exr"),
+            (std::vector<std::string>{"albedo", "depth", "normal", "variance"}));
+  // --aov overrides the scene's film.aov; without either the EXR holds the colour alone.
+  ASSERT_EQ(run("render scene.json -q -o b.exr --set 'film.aov=[\"depth\"]' --aov albedo").code, 0);
+  EXPECT_EQ(layer_names("b.exr"), std::vector<std::string>{"albedo"});
+  ASSERT_EQ(run("render scene.json -q -o c.exr").code, 0);
+  EXPECT_TRUE(layer_names("c.exr").empty());
+  EXPECT_EQ(read_exr((dir_ / "c.exr").string()).rgb, read_exr((dir_ / "scene.exr").string()).rgb);
+}
+
+// A render checkpointed at 2 spp and resumed to 4 writes the colour and the albedo, normal and
+// depth of one render of 4 spp to the bit (the variance to rounding: its sums of squares are
+// added per work unit); a checkpoint without the AOVs is not resumed with them.
+TEST_F(AovCli, CheckpointedAndResumedRendersWriteTheLayersOfOneRender) {
+  ASSERT_EQ(run("render scene.json -q -o once.exr --aov albedo,normal,depth,variance").code, 0);
+  ASSERT_EQ(run("render scene.json -q -o part.exr --spp 2 --checkpoint ck.nck --aov "
+                "albedo,normal,depth,variance")
+                .code,
+            0);
+  const test::Ran resumed =
+      run("render scene.json -q -o resumed.exr --resume ck.nck --spp 4 --aov "
+          "albedo,normal,depth,variance");
+  ASSERT_EQ(resumed.code, 0) << resumed.err;
+  const Image once = read_exr((dir_ / "once.exr").string());
+  const Image again = read_exr((dir_ / "resumed.exr").string());
+  EXPECT_EQ(once.rgb, again.rgb);
+  ASSERT_EQ(once.layers.size(), 4u);
+  ASSERT_EQ(again.layers.size(), 4u);
+  for (size_t i = 0; i < 4; ++i) {
+    ASSERT_EQ(once.layers[i].name, again.layers[i].name);
+    if (once.layers[i].name != "variance") {
+      EXPECT_EQ(once.layers[i].values, again.layers[i].values) << once.layers[i].name;
+      continue;
+    }
+    for (size_t k = 0; k < once.layers[i].values.size(); ++k)
+      EXPECT_NEAR(again.layers[i].values[k], once.layers[i].values[k],
+                  1e-5 * once.layers[i].values[k]);
+  }
+  const test::Ran other = run("render scene.json -q -o other.exr --resume ck.nck --spp 4");
+  EXPECT_EQ(other.code, 2);
+  EXPECT_NE(other.err.find("the checkpoint is of another scene or other settings"),
+            std::string::npos)
+      << other.err;
 }
 
 }  // namespace aov_test
