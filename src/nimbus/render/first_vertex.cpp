@@ -4,8 +4,7 @@
 
 namespace nimbus {
 
-void FirstVertexRecorder::medium(const Scene& scene, const Ray& ray, double t, int inside) {
-  if (!pending_) return;
+void FirstVertexRecorder::record_medium(const Scene& scene, const Ray& ray, double t, int inside) {
   camera_ray_ends(t);
   Rgb mu_s(0.0), mu_t(0.0);
   for_each_medium_at(scene, ray.at(t), inside, [&](int m, double density) {

@@ -23,7 +23,9 @@ class FirstVertexRecorder {
   // A real collision (scattering or absorption) in a medium at distance t, seen from the solid
   // `inside` (-1: the field): the single-scattering albedo of the media's RGB coefficients there
   // (in spectral mode too), normal -ray.d.
-  void medium(const Scene& scene, const Ray& ray, double t, int inside);
+  void medium(const Scene& scene, const Ray& ray, double t, int inside) {
+    if (pending_) record_medium(scene, ray, t, inside);
+  }
 
   // An object's surface at distance t, of outward normal n: a diffuse surface's reflectance, an
   // emissive surface's 0, the normal facing the ray; a dielectric is passed through.
@@ -56,6 +58,7 @@ class FirstVertexRecorder {
   }
 
  private:
+  void record_medium(const Scene& scene, const Ray& ray, double t, int inside);
   void camera_ray_ends(double t) {
     if (camera_ray_) out_->depth = t;
     camera_ray_ = false;
