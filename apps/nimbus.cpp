@@ -2,6 +2,7 @@
 // NAME --out DIR` and `nimbus export-vdb SCENE -o OUT.vdb --voxel-size H`.
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -37,6 +38,7 @@
 #include "nimbus/job/render_job.h"
 #include "nimbus/render/memory_estimate.h"
 #include "nimbus/render/renderer.h"
+#include "nimbus/render/setting_names.h"
 #include "nimbus/render/settings.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
@@ -62,6 +64,7 @@ struct RenderArgs {
   double checkpoint_interval = 0;  // 0: not given (60 s)
   std::string resume;
   std::string display_server;  // HOST:PORT of a tev viewer; "": none
+  std::string aov;             // AOV names, "albedo,normal"; "": the scene's film.aov
 };
 
 // SIGINT, SIGTERM and SIGHUP: the first one during a render stops it before its next pixel
@@ -163,10 +166,23 @@ Outcome attempt(Step&& step) {
   return {};
 }
 
+// The items of "albedo,normal", empty ones included.
+std::vector<std::string> comma_separated(const std::string& list) {
+  std::vector<std::string> items;
+  for (size_t start = 0, comma = 0; comma != std::string::npos; start = comma + 1) {
+    comma = list.find(',', start);
+    items.push_back(list.substr(start, comma - start));
+  }
+  return items;
+}
+
 // The job's options from the command line's (the parts that are the job's).
 nimbus::RenderJobOptions job_options(const RenderArgs& args) {
   nimbus::RenderJobOptions o;
   o.overrides = args.sets;
+  // --aov overrides film.aov, after every --set, as --spp overrides integrator.spp.
+  if (!args.aov.empty())
+    o.overrides.push_back("film.aov=" + nlohmann::json(comma_separated(args.aov)).dump());
   o.spp = args.spp;
   o.seed = args.seed;
   o.threads = args.threads;
@@ -197,14 +213,30 @@ Outcome check_outputs(const RenderArgs& args, const nimbus::RenderJob& job,
   return {};
 }
 
+// With AOVs, every output must be an EXR: a PNG cannot hold their layers.
+Outcome check_aov_outputs(nimbus::AovSet aovs, const std::vector<std::string>& outputs) {
+  if (aovs.empty()) return {};
+  for (const std::string& out : outputs) {
+    std::string ext = std::filesystem::path(out).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (ext != ".exr")
+      return {kExitBadInput,
+              fmt::format("nimbus: -o {}: AOVs (--aov, film.aov) are layers of an EXR; write the "
+                          "render to an .exr",
+                          out)};
+  }
+  return {};
+}
+
 // Writes every output as one transaction (io/atomic_file.h): all of them, or none.
 int write_outputs(const RenderArgs& args, const std::vector<std::string>& outputs,
-                  const nimbus::Film& film, const nlohmann::json& stats) {
+                  const nimbus::Film& film, nimbus::AovSet aovs, const nlohmann::json& stats) {
   using namespace nimbus;
   g_writing = true;
   try {
     OutputTransaction outputs_of_this_run;
-    const Image image = to_image(film);
+    const Image image = to_image(film, aovs);
     for (const std::string& out : outputs) write_image(out, image);
     if (!args.stats.empty()) {
       const std::string text = stats.dump(2) + "\n";
@@ -255,7 +287,9 @@ int finish_render(const RenderArgs& args, const nimbus::RenderJob& job,
                  "nimbus: warning: %llu samples were NaN or of magnitude %.3g or more and "
                  "counted as 0 (counters.rejected_samples in --stats)\n",
                  static_cast<unsigned long long>(n), r.film.max_value());
-  if (const int failed = write_outputs(args, outputs, r.film, job.stats(r)); failed != 0)
+  if (const int failed =
+          write_outputs(args, outputs, r.film, job.scene().settings.aovs, job.stats(r));
+      failed != 0)
     return failed;
   const RenderSettings& s = job.scene().settings;
   if (r.stopped) {
@@ -349,10 +383,8 @@ int run_render(const RenderArgs& args, const Cluster& cluster) {
   if (const int code = agree(cluster, step); code != 0) return code;
 
   std::vector<std::string> outputs = args.outputs;
-  if (outputs.empty()) {
-    const std::string stem = std::filesystem::path(args.scene).stem().string();
-    outputs = {stem + ".exr", stem + ".png"};
-  }
+  const std::string stem = std::filesystem::path(args.scene).stem().string();
+  if (outputs.empty()) outputs = {stem + ".exr", stem + ".png"};
   if (lead) try {
       for (const std::string& out : outputs) check_output_path(out);
       if (!args.stats.empty()) check_writable_path(args.stats);
@@ -361,6 +393,10 @@ int run_render(const RenderArgs& args, const Cluster& cluster) {
       step = {kExitBadInput, fmt::format("nimbus: {}", e.what())};
     }
   if (step.code == 0) step = attempt([&] { job.load(args.scene, spp); });
+  // AOVs are layers of an EXR: the default outputs are then the EXR alone.
+  const AovSet aovs = step.code == 0 ? job.description().settings.aovs : AovSet{};
+  if (!aovs.empty() && args.outputs.empty()) outputs = {stem + ".exr"};
+  if (lead && step.code == 0) step = check_aov_outputs(aovs, outputs);
   if (lead && step.code == 0) step = attempt([&] { job.check(); });
   if (const int code = agree(cluster, step); code != 0) return code;
 
@@ -702,6 +738,24 @@ CLI::Validator unsigned_64() {
       "UINT64");
 }
 
+// --aov's list, "albedo,normal": names of AOVs (render/setting_names.h), none twice.
+CLI::Validator aov_names() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        std::vector<std::string> known, seen;
+        for (const auto& entry : nimbus::kAovNames) known.emplace_back(entry.first);
+        for (const std::string& name : comma_separated(value)) {
+          if (std::find(known.begin(), known.end(), name) == known.end())
+            return fmt::format("unknown AOV \"{}\" (one of: {})", name, fmt::join(known, ", "));
+          if (std::find(seen.begin(), seen.end(), name) != seen.end())
+            return fmt::format("names \"{}\" twice", name);
+          seen.push_back(name);
+        }
+        return {};
+      },
+      "albedo,normal,depth,variance");
+}
+
 // A number of seconds > 0, with the check said in words, as integer_in does.
 CLI::Validator positive_seconds() {
   return CLI::Validator(
@@ -753,6 +807,12 @@ int run_command(int argc, char** argv, const Cluster& cluster) {
       ->add_option("--checkpoint-interval", args.checkpoint_interval,
                    "Seconds between checkpoints (default 60)")
       ->check(positive_seconds());
+  render
+      ->add_option("--aov", args.aov,
+                   "Write these layers into the EXR beside the colour, for denoisers: a "
+                   "comma-separated list of albedo, normal, depth, variance (overrides film.aov; "
+                   "docs/cli.md)")
+      ->check(aov_names());
   render->add_option("--display-server", args.display_server,
                      "Stream the render to a tev viewer at HOST:PORT as it refines (docs/cli.md)");
   render->add_option("--resume", args.resume,

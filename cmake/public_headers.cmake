@@ -34,6 +34,7 @@ set(NIMBUS_PUBLIC_HEADERS
     media/temperature_emission.h
     media/vdb_density.h
     nimbus.h
+    render/aov.h
     render/camera.h
     render/counters.h
     render/exact_sum.h

@@ -3,6 +3,8 @@
 // rendered by the same RenderJob into the pixels `nimbus render` writes, with the GIL released
 // while rendering and SIGINT turned into KeyboardInterrupt.
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -449,13 +451,27 @@ PYBIND11_MODULE(_core, m) {
       py::arg("path"), py::arg("array"));
   m.def(
       "read_exr",
-      [](const std::string& path) {
+      [](const std::string& path, const std::string& layer) {
         nimbus::Image image;
         {
           py::gil_scoped_release release;
           image = nimbus::read_exr(path);
         }
-        return np::to_array(image);
+        if (layer.empty()) return np::to_array(image);
+        std::vector<std::string> names;
+        for (const nimbus::ImageLayer& l : image.layers) {
+          if (l.name != layer) {
+            names.push_back(l.name);
+            continue;
+          }
+          const auto k = py::ssize_t(l.channels.size());
+          py::array_t<float> a({py::ssize_t(image.height), py::ssize_t(image.width), k});
+          std::copy(l.values.begin(), l.values.end(), a.mutable_data());
+          return a;
+        }
+        throw py::value_error(
+            fmt::format("{}: no layer \"{}\" (the file's layers: {})", path, layer,
+                        names.empty() ? "none" : fmt::format("{}", fmt::join(names, ", "))));
       },
-      py::arg("path"));
+      py::arg("path"), py::arg("layer"));
 }

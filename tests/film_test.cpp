@@ -302,7 +302,7 @@ TEST(Film, RoundTripsThroughAFile) {
     const uint32_t version = 99;
     f.write(reinterpret_cast<const char*>(&version), sizeof version);
   }
-  EXPECT_EQ(message(bad), bad + ": film file version 99, this nimbus reads 3");
+  EXPECT_EQ(message(bad), bad + ": film file version 99, this nimbus reads 4");
   std::filesystem::remove_all(dir);
 }
 

@@ -17,7 +17,7 @@ cmake --install "$build" --prefix "$prefix" > "$work/install.log"
 for f in lib/libnimbus_core.a lib/cmake/nimbus/nimbusConfig.cmake \
          lib/cmake/nimbus/nimbusConfigVersion.cmake lib/pkgconfig/nimbus.pc \
          include/nimbus/nimbus.h bin/nimbus share/nimbus/scenes/demo.json \
-         share/nimbus/tools/plot_segments.py; do
+         share/nimbus/tools/plot_segments.py share/nimbus/tools/exr_to_pfm_layers.py; do
   [ -e "$prefix/$f" ] || { echo "test_install: $f was not installed" >&2; exit 1; }
 done
 # The public headers only (docs/api.md): the integrator's templates, for one, stay private.

@@ -238,6 +238,11 @@ def experiment(name, quick=False, seed=0, threads=None):
     return result
 
 
-def read_exr(path):
-    """The R, G, B channels of an EXR file as a float32 array (height, width, 3)."""
-    return _core.read_exr(_os.fspath(path))
+def read_exr(path, layer=None):
+    """The R, G, B channels of an EXR file as a float32 array (height, width, 3); with `layer`,
+    that layer's channels instead (height, width, channels): "albedo" (R, G, B), "normal"
+    (X, Y, Z), "depth" (Z) or "variance" (R, G, B) of a render with AOVs, or any layer NAME of
+    channels NAME.C. ValueError names the file's layers when it has no such layer."""
+    if layer is not None and not isinstance(layer, str):
+        raise TypeError(f"layer must be a str, not {type(layer).__name__}")
+    return _core.read_exr(_os.fspath(path), layer or "")

@@ -7,7 +7,9 @@
 #include <ImfOutputFile.h>
 #include <ImfStandardAttributes.h>
 
+#include <algorithm>
 #include <stdexcept>
+#include <string_view>
 
 #include "nimbus/io/atomic_file.h"
 
@@ -35,6 +37,15 @@ void write_exr(const std::string& path, const Image& image) {
       char* base = reinterpret_cast<char*>(const_cast<float*>(image.rgb.data() + c));
       frame.insert(kChannels[c], Imf::Slice(Imf::FLOAT, base, x_stride, y_stride));
     }
+    for (const ImageLayer& layer : image.layers) {
+      const size_t stride = layer.channels.size() * sizeof(float);
+      for (size_t c = 0; c < layer.channels.size(); ++c) {
+        const std::string name = layer.name + "." + layer.channels[c];
+        header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+        char* base = reinterpret_cast<char*>(const_cast<float*>(layer.values.data() + c));
+        frame.insert(name, Imf::Slice(Imf::FLOAT, base, stride, stride * image.width));
+      }
+    }
     Imf::OutputFile file(temp.c_str(), header);
     file.setFrameBuffer(frame);
     file.writePixels(image.height);
@@ -48,14 +59,42 @@ Image read_exr(const std::string& path) {
     Image image;
     image.width = window.max.x - window.min.x + 1;
     image.height = window.max.y - window.min.y + 1;
-    image.rgb.assign(3 * static_cast<size_t>(image.width) * image.height, 0.0f);
+    const size_t pixels = static_cast<size_t>(image.width) * image.height;
+    image.rgb.assign(3 * pixels, 0.0f);
     Imf::FrameBuffer frame;
+    const auto insert = [&](const std::string& channel, float* base, size_t count) {
+      frame.insert(channel, Imf::Slice::Make(Imf::FLOAT, base, window, count * sizeof(float),
+                                             count * sizeof(float) * image.width));
+    };
     for (int c = 0; c < 3; ++c) {
       if (!file.header().channels().findChannel(kChannels[c]))
         throw std::runtime_error(std::string("no ") + kChannels[c] + " channel");
-      frame.insert(kChannels[c],
-                   Imf::Slice::Make(Imf::FLOAT, image.rgb.data() + c, window, 3 * sizeof(float),
-                                    3 * sizeof(float) * image.width));
+      insert(kChannels[c], image.rgb.data() + c, 3);
+    }
+    const Imf::ChannelList& list = file.header().channels();
+    for (auto it = list.begin(); it != list.end(); ++it) {
+      const std::string channel = it.name();
+      const size_t dot = channel.rfind('.');
+      if (dot == std::string::npos) continue;
+      const std::string name = channel.substr(0, dot);
+      auto layer = std::find_if(image.layers.begin(), image.layers.end(),
+                                [&](const ImageLayer& l) { return l.name == name; });
+      if (layer == image.layers.end()) layer = image.layers.insert(layer, {name, {}, {}});
+      layer->channels.push_back(channel.substr(dot + 1));
+    }
+    for (ImageLayer& layer : image.layers) {
+      // Colours and vectors in their usual order; OpenEXR lists channels by name.
+      const auto rank = [](const std::string& c) {
+        const size_t at = std::string_view("RGBAXYZ").find(c);
+        return c.size() == 1 && at != std::string_view::npos ? int(at) : 7;
+      };
+      std::stable_sort(
+          layer.channels.begin(), layer.channels.end(),
+          [&](const std::string& a, const std::string& b) { return rank(a) < rank(b); });
+      const size_t k = layer.channels.size();
+      layer.values.assign(k * pixels, 0.0f);
+      for (size_t c = 0; c < k; ++c)
+        insert(layer.name + "." + layer.channels[c], layer.values.data() + c, k);
     }
     file.setFrameBuffer(frame);
     file.readPixels(window.min.y, window.max.y);

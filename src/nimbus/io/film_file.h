@@ -10,8 +10,9 @@
 namespace nimbus {
 
 // Saves the film to a file, atomically (io/atomic_file.h): a versioned little-endian binary of
-// the size and the exponent, then per pixel the count, the three exact sums (128-bit fixed point,
-// in units of 2^(exponent - 64)) and the three sums of squares (doubles).
+// the size, the exponent, the AOV layers and their depth exponent, then per pixel the count, the
+// three exact sums (128-bit fixed point, in units of 2^(exponent - 64)) and the three sums of
+// squares (doubles), then each AOV sum held for every pixel (render/aov.h, AovSums).
 void save_film(const Film& film, const std::string& path);
 
 // Loads a film saved by save_film; std::runtime_error("PATH: problem") if the file is missing,

@@ -6,7 +6,8 @@
 
 namespace nimbus {
 
-static_assert(std::is_trivially_copyable_v<ExactRgb> && std::is_trivially_copyable_v<Rgb>);
+static_assert(std::is_trivially_copyable_v<ExactRgb> && std::is_trivially_copyable_v<Rgb> &&
+              std::is_trivially_copyable_v<int128>);
 
 FilmPatch take_patch(Film& film, const PixelRect& r) {
   FilmPatch p;
@@ -14,15 +15,18 @@ FilmPatch take_patch(Film& film, const PixelRect& r) {
   p.samples.reserve(r.pixels());
   p.sum.reserve(r.pixels());
   p.sum_sq.reserve(r.pixels());
+  p.aov = AovSums(film.aov.layers, size_t(r.pixels()), film.aov.depth_exponent);
   for (int y = r.y0; y < r.y1; ++y)
     for (int x = r.x0; x < r.x1; ++x) {
       const size_t i = size_t(y) * film.width + x;
+      p.aov.add(p.samples.size(), film.aov, i);
       p.samples.push_back(film.samples[i]);
       p.sum.push_back(film.sum[i]);
       p.sum_sq.push_back(film.sum_sq[i]);
       film.samples[i] = 0;
       film.sum[i] = ExactRgb{};
       film.sum_sq[i] = Rgb(0.0);
+      film.aov.clear(i);
     }
   return p;
 }
@@ -32,6 +36,8 @@ void merge_patch(Film& film, const FilmPatch& p) {
   if (r.x0 < 0 || r.y0 < 0 || r.x1 > film.width || r.y1 > film.height || r.x0 > r.x1 ||
       r.y0 > r.y1 || p.samples.size() != size_t(r.pixels()))
     throw std::invalid_argument("a film patch outside the film");
+  if (p.aov.layers != film.aov.layers || p.aov.depth_exponent != film.aov.depth_exponent)
+    throw std::invalid_argument("a film patch of other AOV layers than the film's");
   size_t k = 0;
   for (int y = r.y0; y < r.y1; ++y)
     for (int x = r.x0; x < r.x1; ++x, ++k) {
@@ -39,6 +45,7 @@ void merge_patch(Film& film, const FilmPatch& p) {
       film.samples[i] += p.samples[k];
       film.sum[i] += p.sum[k];
       film.sum_sq[i] += p.sum_sq[k];
+      film.aov.add(i, p.aov, k);
     }
 }
 
@@ -66,6 +73,10 @@ std::vector<std::byte> pack_patch(const FilmPatch& p) {
   append(out, p.samples.data(), p.samples.size());
   append(out, p.sum.data(), p.sum.size());
   append(out, p.sum_sq.data(), p.sum_sq.size());
+  const uint8_t layers = p.aov.layers.bits();
+  append(out, &layers, 1);
+  append(out, &p.aov.depth_exponent, 1);
+  p.aov.for_each_vector([&](const auto& v) { append(out, v.data(), v.size()); });
   return out;
 }
 
@@ -82,6 +93,14 @@ FilmPatch unpack_patch(std::span<const std::byte> in) {
   extract(in, p.samples.data(), n);
   extract(in, p.sum.data(), n);
   extract(in, p.sum_sq.data(), n);
+  uint8_t layers = 0;
+  int depth_exponent = 0;
+  extract(in, &layers, 1);
+  extract(in, &depth_exponent, 1);
+  if (layers != AovSet::from_bits(layers).recorded().bits())
+    throw std::runtime_error("a film patch with unknown AOV layers");
+  p.aov = AovSums(AovSet::from_bits(layers), n, depth_exponent);
+  p.aov.for_each_vector([&](auto& v) { extract(in, v.data(), v.size()); });
   if (!in.empty()) throw std::runtime_error("trailing bytes after a film patch");
   return p;
 }

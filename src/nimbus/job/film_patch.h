@@ -21,6 +21,7 @@ struct FilmPatch {
   std::vector<uint32_t> samples;  // row by row
   std::vector<ExactRgb> sum;
   std::vector<Rgb> sum_sq;
+  AovSums aov;  // the film's AOV sums, for the rectangle's pixels
 };
 
 // Moves the rectangle's pixels out of `film` (which then holds no samples there).

@@ -87,6 +87,7 @@ void RenderJob::check() const {
   const int width = compiled_ ? scene_.settings.width : desc_.settings.width;
   const int height = compiled_ ? scene_.settings.height : desc_.settings.height;
   const int spp = compiled_ ? scene_.settings.spp : desc_.settings.spp;
+  const AovSet aovs = compiled_ ? scene_.settings.aovs : desc_.settings.aovs;
   if (resumed_) {
     const std::string& file = options_.resume;
     // The document and the settings now; the files it reads once they are read (check_compiled).
@@ -103,6 +104,11 @@ void RenderJob::check() const {
     if (resumed_->film.width != width || resumed_->film.height != height)
       throw JobError(fmt::format("--resume {}: a film of {}x{} pixels, the scene's image is {}x{}",
                                  file, resumed_->film.width, resumed_->film.height, width, height));
+    // The document holds film.aov, but a scene built in code stands for it by its identity.
+    if (resumed_->film.aov.layers != aovs.recorded())
+      throw JobError(fmt::format(
+          "--resume {}: the checkpoint's film holds the sums of other AOVs than this render's",
+          file));
     const uint32_t most =
         *std::max_element(resumed_->film.samples.begin(), resumed_->film.samples.end());
     if (most > uint32_t(spp))
@@ -139,6 +145,13 @@ void RenderJob::check_compiled() const {
         "nimbus build?)",
         file, resumed_->film.exponent - kExactSumFractionBits,
         scene_.film_exponent - kExactSumFractionBits));
+  if (resumed_->film.aov.layers.has(Aov::Depth) &&
+      resumed_->film.aov.depth_exponent != depth_exponent(scene_))
+    throw JobError(fmt::format(
+        "--resume {}: the checkpoint's film sums depths in units of 2^{}, this render's in 2^{} "
+        "(another nimbus build?)",
+        file, resumed_->film.aov.depth_exponent - kExactSumFractionBits,
+        depth_exponent(scene_) - kExactSumFractionBits));
 }
 
 JobOutcome RenderJob::run(JobChannel* channel) {
@@ -168,8 +181,9 @@ JobOutcome RenderJob::run_at_once() {
 JobOutcome RenderJob::run_in_passes() {
   // A pass is one call of the renderer over tiles, so only its last tiles leave threads idle
   // (work units of 0.5 s left one of two threads idle at the end of each: 4 %, passes 2.5 %;
-  // issue 28). Passes grow until one lasts half a second, the display's interval; the film after each is the image so far, and at
-  // the end the bits of one call, since the exact sums do not depend on the split.
+  // issue 28). Passes grow until one lasts half a second, the display's interval; the film after
+  // each is the image so far, and at the end the bits of one call, since the exact sums do not
+  // depend on the split.
   constexpr double kDisplayInterval = 0.5;
   const int spp = scene_.settings.spp;
   JobOutcome outcome;
@@ -321,7 +335,7 @@ void check_render_memory(const SceneDesc& desc, int threads, std::optional<uint6
       desc.settings.spectral.mode == SpectralSettings::Mode::Spectral ? kSpectralBins : 3;
   const int workers = threads > 0 ? threads : int(std::thread::hardware_concurrency());
   MemoryEstimate need = estimate_render_memory(desc.settings.width, desc.settings.height, octrees,
-                                               bins, workers, field_objects);
+                                               bins, workers, field_objects, desc.settings.aovs);
   need.objects = object_memory(desc);
   const uint64_t limit = max_memory ? *max_memory : available_memory();
   if (limit > 0 && need.total() > double(limit))

@@ -156,7 +156,7 @@ SharedRenderResult lead_shared_render(const Scene& scene, JobChannel* channel,
   std::exception_ptr local_failure;
   std::thread local([&] {
     try {
-      Film scratch(scene.settings.width, H, scene.film_exponent);
+      Film scratch = make_film(scene);
       while (const std::optional<WorkUnit> u = queue.wait_next()) {
         const UnitResult r = render_unit(scene, scratch, *u, s.threads, stop);
         if (r.stats.cancelled)

@@ -30,6 +30,8 @@ void merge(Film& into, const Film& from) {
   if (into.exponent != from.exponent)
     throw std::invalid_argument(
         fmt::format("merging films of exponents {} and {}", into.exponent, from.exponent));
+  if (into.aov.layers != from.aov.layers || into.aov.depth_exponent != from.aov.depth_exponent)
+    throw std::invalid_argument("merging films of different AOV layers");
   for (int p = 0; p < into.pixels(); ++p) {
     if (from.samples[p] == 0) continue;
     if (into.samples[p] == 0) {
@@ -39,6 +41,7 @@ void merge(Film& into, const Film& from) {
       into.sum[p] += from.sum[p];
       into.sum_sq[p] += from.sum_sq[p];
     }
+    into.aov.add(size_t(p), from.aov, size_t(p));
     into.samples[p] += from.samples[p];
   }
 }

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "nimbus/render/aov.h"
 #include "nimbus/render/exact_sum.h"
 #include "nimbus/spectral/spectrum.h"
 
@@ -26,15 +27,17 @@ struct Film {
   std::vector<ExactRgb> sum;  // exact
   std::vector<Rgb> sum_sq;
   std::vector<uint32_t> samples;  // per pixel
+  AovSums aov;                    // the AOVs' sums (render/aov.h), for those asked for
 
   Film() = default;
-  Film(int w, int h, int exponent_ = 0)
+  Film(int w, int h, int exponent_ = 0, AovSet aovs = {}, int depth_exponent = 0)
       : width(w),
         height(h),
         exponent(exponent_),
         sum(size_t(w) * h),
         sum_sq(size_t(w) * h),
-        samples(size_t(w) * h, 0) {}
+        samples(size_t(w) * h, 0),
+        aov(aovs, size_t(w) * h, depth_exponent) {}
   int pixels() const { return width * height; }
   // The largest magnitude a sample may have: 2^(62 + exponent) (4.6e18 at exponent 0).
   double max_value() const { return std::ldexp(kExactSumMaxValue, exponent); }
@@ -66,9 +69,9 @@ struct Film {
 // sums resolve 2^-86 of it. A scene lit at 10^19 or at 10^-20 is then summed as one lit at 1.
 int film_exponent(double brightest);
 
-// Adds `from` into `into` (films of one size and exponent, else std::invalid_argument): a pixel
-// `into` has no samples of takes `from`'s sums as they are; otherwise the sums and counts are added
-// (the exact sums exactly).
+// Adds `from` into `into` (films of one size, exponent and AOV layers, else
+// std::invalid_argument): a pixel `into` has no samples of takes `from`'s sums as they are;
+// otherwise the sums and counts are added (the exact sums exactly).
 void merge(Film& into, const Film& from);
 
 // The average of a set of pixel means and its standard error (pixels are independent).

@@ -15,6 +15,7 @@
 #include "nimbus/math/rng.h"
 #include "nimbus/media/medium_field.h"
 #include "nimbus/render/counters.h"
+#include "nimbus/render/first_vertex.h"
 #include "nimbus/render/light_choice.h"
 #include "nimbus/render/path_sampler.h"
 #include "nimbus/render/path_spectra.h"
@@ -137,11 +138,14 @@ PhaseSample<N> draw_phase(const MediumPoint<N>& m, const Vec3& dir, PathSampler&
 // The one path loop: radiance along a camera ray, with the tracking mode's policy
 // (tracking_policies.h) for what differs between modes. Each bounce takes its numbers from its
 // block of the sampler's dimensions (SampleDims), the tracking estimators from the path's stream.
+// With `first`, also what the path met first, for the AOVs (render/first_vertex.h); recording
+// draws no number, so the radiance is the same bits with or without it.
 template <int N, class Policy>
 Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, PathSampler& sampler,
-                       Counters& counters, Policy& policy) {
+                       Counters& counters, Policy& policy, FirstVertex* first = nullptr) {
   using namespace integrator_detail;
   ++counters.paths;
+  FirstVertexRecorder record(first);
   Rng& rng = sampler.rng();
   const int slots = light_slots(scene);  // per bounce, in the sampler's dimensions
   Spectrum<N> L(0.0);
@@ -162,6 +166,7 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
     const MediumEvent<N> ev = policy.collide(scene, ps, ray, t_surface, inside, rng, counters);
     sampler.done();
     L += ev.emitted;
+    if (ev.type != MediumEvent<N>::Type::None) record.medium(scene, ray, ev.t, inside);
     if (ev.type == MediumEvent<N>::Type::Absorb) break;
     if (ev.type == MediumEvent<N>::Type::Scatter) {
       if (depth >= scene.settings.max_depth) break;
@@ -186,12 +191,14 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
     }
 
     if (!hit) {
+      record.escape();
       for (const int i : scene.lights_at_infinity)
         L += policy.light_hit(light_emission(ps, scene, i), scene.lights[i], prev_p, ray.d,
                               light_sampled, light_sampling_pdf(scene, ps, i, prev_p));
       break;
     }
     if (hit->light >= 0) {
+      record.light(scene.lights[hit->light], ray, hit->t);
       L +=
           policy.light_hit(light_emission(ps, scene, hit->light), scene.lights[hit->light], prev_p,
                            ray.d, light_sampled, light_sampling_pdf(scene, ps, hit->light, prev_p));
@@ -200,6 +207,7 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
     const SceneObject& obj = scene.objects[hit->object];
     const Vec3 p = ray.at(hit->t);
     const Vec3 n = outward_normal(obj, p);
+    record.surface(obj.surface, ray, hit->t, n);
     if (obj.surface.type == Surface::Type::Emissive) {
       if (dot(ray.d, n) < 0) L += policy.emission(evaluate(obj.surface.radiance, ps.ch));
       break;

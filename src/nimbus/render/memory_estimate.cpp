@@ -17,12 +17,13 @@
 namespace nimbus {
 
 MemoryEstimate estimate_render_memory(int width, int height, std::size_t octrees, int bins,
-                                      int threads, std::size_t field_objects) {
+                                      int threads, std::size_t field_objects, AovSet aovs) {
   const double pixels = double(width) * double(height);
   MemoryEstimate e;
-  e.film = pixels * (sizeof(ExactRgb) + sizeof(Rgb) + sizeof(uint32_t));
+  e.film =
+      pixels * double(sizeof(ExactRgb) + sizeof(Rgb) + sizeof(uint32_t) + aov_film_bytes(aovs));
   // The float image, and as much again for a writer's rows (EXR slices, PNG bytes).
-  e.image = 2 * pixels * 3 * sizeof(float);
+  e.image = 2 * pixels * double(3 + aov_image_floats(aovs)) * sizeof(float);
   // At the node budget, while building: the node, its bounds, its centre, level and list of
   // members (one, in a solid), and the pruned copy.
   const double per_node = sizeof(OctreeNode) + 2.0 * bins * sizeof(double) + sizeof(Vec3) + 4 +

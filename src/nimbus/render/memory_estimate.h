@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <string>
 
+#include "nimbus/render/aov.h"
+
 namespace nimbus {
 
 struct MemoryEstimate {
@@ -27,9 +29,9 @@ double object_memory(std::size_t copies, std::size_t quadrics);
 
 // For an image of width × height, `octrees` majorant octrees (the field's and one per solid
 // holding a medium) with `bins` bounds each per node, `field_objects` index-matched objects
-// holding a medium, rendered on `threads` threads.
+// holding a medium, rendered on `threads` threads, with the AOV layers `aovs`.
 MemoryEstimate estimate_render_memory(int width, int height, std::size_t octrees, int bins,
-                                      int threads, std::size_t field_objects);
+                                      int threads, std::size_t field_objects, AovSet aovs = {});
 
 // The memory the system can still give (MemAvailable of /proc/meminfo), or 0 when unknown.
 std::uint64_t available_memory();

@@ -37,6 +37,8 @@ RenderStats render_tiles(const Scene& scene, Film& film, const RenderRange& rang
   std::mutex progress_mutex;
   const auto start = std::chrono::steady_clock::now();
   const ZSobol zsobol(W, scene.settings.height, scene.settings.seed);
+  // The first vertex is recorded only into a film that holds AOV sums (render/aov.h).
+  const bool record_first_vertex = !film.aov.layers.empty();
 
   constexpr int kTile = 16;
   tbb::parallel_for(
@@ -58,8 +60,11 @@ RenderStats render_tiles(const Scene& scene, Film& film, const RenderRange& rang
               const Ray ray = scene.camera.generate(x + u[0], y + u[1]);
               if (spectral) prepare_path_spectra(ps, scene, sampler.get1d(SampleDims::kWavelength));
               auto policy = make_policy(sampler);
-              const Spectrum<N> L = trace_path(scene, ps, ray, sampler, local, policy);
+              FirstVertex first;
+              const Spectrum<N> L = trace_path(scene, ps, ray, sampler, local, policy,
+                                               record_first_vertex ? &first : nullptr);
               if (!film.add(pixel, to_film_rgb(L, ps.ch))) ++local.rejected_samples;
+              if (record_first_vertex) film.aov.add(size_t(pixel), first);
             }
           }
         const long done = pixels_done += long(tile.rows().size()) * long(tile.cols().size());

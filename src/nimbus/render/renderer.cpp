@@ -33,6 +33,12 @@ RenderRange resolve(const Scene& scene, const Film& film, RenderRange r) {
         fmt::format("the film's exponent is {}, the scene's {}: a film made for another scene's "
                     "light (make_film)",
                     film.exponent, scene.film_exponent));
+  if (film.aov.layers.has(Aov::Depth) && film.aov.depth_exponent != depth_exponent(scene))
+    throw std::invalid_argument(fmt::format(
+        "the film's depths are summed in units of 2^{}, the scene's in 2^{}: a film made for "
+        "another scene (make_film)",
+        film.aov.depth_exponent - kExactSumFractionBits,
+        depth_exponent(scene) - kExactSumFractionBits));
   if (r.x1 < 0) r.x1 = W;
   if (r.y1 < 0) r.y1 = H;
   if (r.s1 < 0) r.s1 = scene.settings.spp;

@@ -210,8 +210,13 @@ double brightest_emission(const Scene& scene) {
   return b;
 }
 
+int depth_exponent(const Scene& scene) {
+  return film_exponent(scene.scale + length(scene.camera.origin));
+}
+
 Film make_film(const Scene& scene) {
-  return Film(scene.settings.width, scene.settings.height, scene.film_exponent);
+  return Film(scene.settings.width, scene.settings.height, scene.film_exponent, scene.settings.aovs,
+              depth_exponent(scene));
 }
 
 void complete_spectra(Scene& scene) {

@@ -63,6 +63,7 @@ struct RenderSettings {
   SpectralSettings spectral;
   Sampler sampler = Sampler::ZSobol;
   LightSampling light_sampling = LightSampling::One;
+  AovSet aovs = {};  // the layers written beside the colour (render/aov.h)
 };
 
 struct SceneObject {
@@ -134,7 +135,11 @@ bool occluded(const Scene& scene, const Ray& ray, double t_max, int target_light
 // bin; 0 for a scene that emits nothing. Call after complete_spectra.
 double brightest_emission(const Scene& scene);
 
-// A fresh film for the scene: its image's size and its film exponent.
+// The exponent of a film's depth sums (AovSums): film_exponent of the scene's size plus the
+// camera's distance from the origin, the scale of the distances its camera rays meet things at.
+int depth_exponent(const Scene& scene);
+
+// A fresh film for the scene: its image's size, its film exponent and its AOV layers.
 Film make_film(const Scene& scene);
 
 // Gives every colour input of the scene its spectral curve (spectral_param.h), by role; spectral

@@ -42,6 +42,12 @@ inline constexpr std::array<std::pair<std::string_view, RenderSettings::LightSam
     kLightSamplingNames = {
         {{"all", RenderSettings::LightSampling::All}, {"one", RenderSettings::LightSampling::One}}};
 
+inline constexpr std::array<std::pair<std::string_view, Aov>, 4> kAovNames = {
+    {{"albedo", Aov::Albedo},
+     {"normal", Aov::Normal},
+     {"depth", Aov::Depth},
+     {"variance", Aov::Variance}}};
+
 // The name of a value in its table.
 template <class E, size_t K>
 constexpr std::string_view name_of(const std::array<std::pair<std::string_view, E>, K>& table,

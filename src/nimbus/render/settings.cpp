@@ -61,6 +61,29 @@ Setting choice(std::string_view key, std::string_view noun,
           {}};
 }
 
+// The set of AOVs, written as an array of their names in the order of kAovNames.
+Setting aov_list(std::string_view key, std::string_view doc) {
+  std::vector<std::string_view> names;
+  for (const auto& entry : kAovNames) names.push_back(entry.first);
+  return {key,
+          {Kind::ChoiceList, {}, names, "AOV"},
+          doc,
+          [](const RenderSettings& s) {
+            nlohmann::json list = nlohmann::json::array();
+            for (const auto& [name, aov] : kAovNames)
+              if (s.aovs.has(aov)) list.push_back(std::string(name));
+            return list;
+          },
+          [](RenderSettings& s, const nlohmann::json& v) {
+            s.aovs = {};
+            for (const auto& [name, aov] : kAovNames)
+              for (const nlohmann::json& given : v)
+                if (given.get<std::string>() == name) s.aovs.add(aov);
+          },
+          {},
+          {}};
+}
+
 std::vector<Setting> make_settings() {
   Setting seed = plain<uint64_t>(
       "integrator.seed", Kind::Unsigned, {},
@@ -74,6 +97,8 @@ std::vector<Setting> make_settings() {
       integer(
           "film.height", between(1, 16384), "image height in pixels",
           [](auto& s) -> auto& { return s.height; }),
+      aov_list("film.aov",
+               "AOV layers written into the EXR beside the colour, for denoisers (as `--aov`)"),
       integer(
           "integrator.spp", at_least(1), "samples per pixel",
           [](auto& s) -> auto& { return s.spp; }),
@@ -153,10 +178,12 @@ std::string type_text(const Setting& s) {
       return "integer >= 0";
     case Kind::Boolean:
       return "boolean";
-    case Kind::Choice: {
+    case Kind::Choice:
+    case Kind::ChoiceList: {
       std::vector<std::string> quoted;
       for (std::string_view n : s.type.names) quoted.push_back(fmt::format("`\"{}\"`", n));
-      return fmt::format("{}", fmt::join(quoted, ", "));
+      const std::string names = fmt::format("{}", fmt::join(quoted, ", "));
+      return s.type.kind == Kind::Choice ? names : "array of distinct " + names;
     }
   }
   return "";

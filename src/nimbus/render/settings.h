@@ -22,11 +22,12 @@
 namespace nimbus {
 
 struct SettingType {
-  enum class Kind { Integer, Unsigned, Number, Boolean, Choice };
+  // ChoiceList: an array of distinct names, each a Choice's.
+  enum class Kind { Integer, Unsigned, Number, Boolean, Choice, ChoiceList };
   Kind kind = Kind::Integer;
   Range range;                          // Integer, Number
-  std::vector<std::string_view> names;  // Choice: the names a file may give
-  std::string_view noun;                // Choice: what messages call it ("tracking", "sampler")
+  std::vector<std::string_view> names;  // Choice, ChoiceList: the names a file may give
+  std::string_view noun;                // Choice, ChoiceList: what messages call one ("tracking")
 };
 
 struct Setting {

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -273,6 +274,15 @@ class Loader {
         break;
       case Kind::Choice:
         value = std::string(s.type.names[x.choice(s.type.noun, s.type.names)]);
+        break;
+      case Kind::ChoiceList:
+        value = nlohmann::json::array();
+        for (const JsonValue& e : x.array()) {
+          const std::string name(s.type.names[e.choice(s.type.noun, s.type.names)]);
+          if (std::find(value.begin(), value.end(), name) != value.end())
+            e.fail(fmt::format("\"{}\" is listed twice", name));
+          value.push_back(name);
+        }
         break;
     }
     if (s.check)
