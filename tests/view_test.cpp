@@ -95,6 +95,23 @@ TEST_F(Session, RefinesToTheBitsOfRenderThenFollowsTheCamera) {
   EXPECT_EQ(f.film_image->rgb, reference(scene_, {"camera.from=[2, 1.5, 5]"}).rgb);
 }
 
+TEST_F(Session, TheFilmsImageHasTheScenesAovLayers) {
+  ViewOptions o = options();
+  o.overrides = {R"(film.aov=["albedo", "depth"])"};
+  ViewSession session(o);
+  ASSERT_TRUE(session.wait(done, 60));
+  const ViewFrame f = session.frame();
+  RenderOptions ro;
+  ro.threads = 2;
+  const SceneDesc desc = load_scene_file(scene_, o.overrides);
+  const Image expected = to_image(render(compile_scene(desc), ro).film, desc.settings.aovs);
+  ASSERT_EQ(f.film_image->layers.size(), 2u);
+  EXPECT_EQ(f.film_image->layers[0].name, "albedo");
+  EXPECT_EQ(f.film_image->layers[0].values, expected.layers[0].values);
+  EXPECT_EQ(f.film_image->layers[1].values, expected.layers[1].values);
+  EXPECT_EQ(f.film_image->rgb, expected.rgb);
+}
+
 TEST_F(Session, ShowsAPreviewWhileTheCameraMoves) {
   ViewOptions o = options();
   o.rest = 30;  // the camera never rests in this test

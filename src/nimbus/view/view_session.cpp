@@ -193,7 +193,8 @@ void ViewSession::render_pass() {
   render_seconds_ += stats.seconds;
   pass_spp_ =
       std::clamp(int(pass_spp_ * kPassSeconds / std::max(stats.seconds, 1e-3)), 1, 2 * pass_spp_);
-  publish(std::make_shared<Image>(to_image(film_)), false);
+  // With the scene's AOVs (film.aov), as `nimbus render` writes them: the saved EXR has them.
+  publish(std::make_shared<Image>(to_image(film_, scene_->settings.aovs)), false);
 }
 
 void ViewSession::loop() {
