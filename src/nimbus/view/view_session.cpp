@@ -12,6 +12,7 @@
 #include "nimbus/render/renderer.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
+#include "nimbus/spectral/color.h"
 #include "nimbus/view/preview.h"
 
 namespace nimbus {
@@ -29,7 +30,7 @@ constexpr double kPassSeconds = 0.3;
 }  // namespace
 
 double view_noise(const Film& film) {
-  const auto luminance = [](const Rgb& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; };
+  const auto luminance = [](const Rgb& c) { return linear_srgb_to_xyz(c).y; };
   double var = 0, mean = 0;
   for (int p = 0; p < film.pixels(); ++p) {
     if (film.samples[size_t(p)] < 2) return 0;
@@ -91,7 +92,9 @@ bool ViewSession::files_changed() const {
 }
 
 bool ViewSession::load() {
-  // What is watched is stamped before it is read: an edit made while it loads is seen next time.
+  // The scene file is stamped before it is read, so that an edit made while it loads is seen next
+  // time; the files it names are stamped once they are known, after reading. A load that fails
+  // keeps watching the files of the last good one.
   std::vector<Stamp> watched{stamp(options_.scene)};
   for (size_t i = 1; i < watched_.size(); ++i) watched.push_back(stamp(watched_[i].path));
   try {

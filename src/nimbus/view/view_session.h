@@ -117,9 +117,10 @@ class ViewSession {
   std::thread thread_;
 };
 
-// The noise of a film as one number: the root mean square over pixels of the standard error of
-// their means' luminance, relative to the image's mean luminance (Rec. 709 weights); 0 for a film
-// without two samples a pixel or without light.
+// The noise of a film as one number: over pixels, the root mean square of the standard error of
+// their means, the channels' variances weighted as luminance weighs the channels (linear sRGB's
+// Y), relative to the image's mean luminance; 0 for a film without two samples a pixel or
+// without light.
 double view_noise(const Film& film);
 
 }  // namespace nimbus
