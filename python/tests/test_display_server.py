@@ -148,3 +148,23 @@ def test_a_bad_address_is_refused(tmp_path):
         assert run.returncode == 2, address
         assert run.stderr.startswith(f"nimbus: --display-server {address}:"), run.stderr
         assert not (tmp_path / "x.exr").exists()
+
+
+def test_a_viewer_that_stops_reading_does_not_stop_the_render(tmp_path):
+    # It accepts and never reads: the sending thread blocks once the socket's buffers are full
+    # (at most 4 MiB sent, the kernel's tcp_wmem, and 4 KiB received, for 0.9 MB an update; one
+    # thread renders this in 6 s here, an update each 0.5 s) and gives the viewer up after its
+    # send timeout; the render goes on, and its image is the one rendered without a viewer.
+    server = socket.socket()
+    server.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    server.bind(("127.0.0.1", 0))
+    server.listen(4)
+    port = server.getsockname()[1]
+    try:
+        image, err = render(tmp_path, "a.exr", "--display-server", f"127.0.0.1:{port}",
+                            "--threads", "1", spp=16, size=(320, 240))
+    finally:
+        server.close()
+    assert_one_warning(err, "the viewer stopped reading (nothing taken for 2 s)")
+    plain, _ = render(tmp_path, "b.exr", spp=16, size=(320, 240))
+    assert np.array_equal(plain, image)

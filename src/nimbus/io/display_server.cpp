@@ -25,14 +25,15 @@ double now_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-// Little-endian packet writer: tev's wire format.
+// Little-endian packet writer into a reused buffer: tev's wire format.
 struct Packet {
-  std::vector<std::uint8_t> bytes{0, 0, 0, 0};  // the length, filled in by done()
+  std::vector<std::uint8_t>& bytes;
+  explicit Packet(std::vector<std::uint8_t>& buffer) : bytes(buffer) { bytes.assign(4, 0); }
   template <class T>
   void put(T value) {
-    std::uint8_t b[sizeof(T)];
-    std::memcpy(b, &value, sizeof(T));  // x86-64 and aarch64 are little-endian
-    bytes.insert(bytes.end(), b, b + sizeof(T));
+    const size_t at = bytes.size();
+    bytes.resize(at + sizeof(T));
+    std::memcpy(bytes.data() + at, &value, sizeof(T));  // x86-64 and aarch64 are little-endian
   }
   void put_string(const std::string& s) {
     bytes.insert(bytes.end(), s.begin(), s.end());
@@ -44,6 +45,15 @@ struct Packet {
     return bytes;
   }
 };
+
+// Only what the means need is copied: the sums and the counts (2 MB for 320 x 240 pixels).
+void stage(Film& to, const Film& film) {
+  to.width = film.width;
+  to.height = film.height;
+  to.exponent = film.exponent;
+  to.sum = film.sum;
+  to.samples = film.samples;
+}
 
 }  // namespace
 
@@ -59,10 +69,50 @@ DisplayServer::DisplayServer(const std::string& address, std::string name,
       std::stoi(port_) < 1 || std::stoi(port_) > 65535)
     throw std::invalid_argument("--display-server " + address +
                                 ": the port must be a number in [1, 65535]");
+  sender_ = std::thread([this] { send_loop(); });
 }
 
 DisplayServer::~DisplayServer() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_one();
+  sender_.join();
   if (socket_ >= 0) ::close(socket_);
+}
+
+void DisplayServer::send_loop() {
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    wake_.wait(lock, [this] { return pending_ || stop_; });
+    if (stop_) return;
+    pending_ = false;
+    sending_ = true;
+    lock.unlock();
+    send_changes(staged_);
+    lock.lock();
+    sending_ = false;
+    idle_.notify_all();
+  }
+}
+
+void DisplayServer::update(const Film& film) {
+  {
+    std::lock_guard lock(mutex_);
+    if (pending_ || sending_) return;
+    stage(staged_, film);
+    pending_ = true;
+  }
+  wake_.notify_one();
+}
+
+void DisplayServer::finish(const Film& film) {
+  std::unique_lock lock(mutex_);
+  idle_.wait(lock, [this] { return !pending_ && !sending_; });
+  // The thread waits for the mutex, held here until the last update is sent.
+  next_attempt_ = 0;
+  send_changes(film);
 }
 
 void DisplayServer::drop(const std::string& why) {
@@ -120,7 +170,12 @@ bool DisplayServer::send_all(const std::vector<std::uint8_t>& packet) {
   for (size_t sent = 0; sent < packet.size();) {
     const ssize_t n = ::send(socket_, packet.data() + sent, packet.size() - sent, MSG_NOSIGNAL);
     if (n <= 0) {
-      drop(std::string("the viewer went away (") + (n < 0 ? std::strerror(errno) : "closed") + ")");
+      if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK))
+        drop("the viewer stopped reading (nothing taken for " +
+             std::to_string(kSendTimeoutSeconds) + " s)");
+      else
+        drop(std::string("the viewer went away (") + (n < 0 ? std::strerror(errno) : "closed") +
+             ")");
       return false;
     }
     sent += size_t(n);
@@ -128,16 +183,11 @@ bool DisplayServer::send_all(const std::vector<std::uint8_t>& packet) {
   return true;
 }
 
-void DisplayServer::finish(const Film& film) {
-  next_attempt_ = 0;
-  update(film);
-}
-
-void DisplayServer::update(const Film& film) {
+void DisplayServer::send_changes(const Film& film) {
   const bool fresh = socket_ < 0;
   if (fresh) {
     if (now_seconds() < next_attempt_ || !connect_once()) return;
-    Packet create;
+    Packet create(packet_);
     create.put(kCreateImage);
     create.put<std::uint8_t>(1);  // grab focus
     create.put_string(name_);
@@ -158,7 +208,7 @@ void DisplayServer::update(const Film& film) {
           changed =
               film.samples[size_t(y) * film.width + x] != sent_samples_[size_t(y) * film.width + x];
       if (!changed) continue;
-      Packet tile;
+      Packet tile(packet_);
       tile.put(kUpdateImage);
       tile.put<std::uint8_t>(0);
       tile.put_string(name_);
@@ -167,11 +217,16 @@ void DisplayServer::update(const Film& film) {
       for (const int v : {x0, y0, w, h}) tile.put<std::int32_t>(v);
       for (std::int64_t c = 0; c < 3; ++c) tile.put<std::int64_t>(c);  // offsets
       for (int c = 0; c < 3; ++c) tile.put<std::int64_t>(3);           // strides
+      const size_t data = packet_.size();
+      packet_.resize(data + size_t(w) * h * 3 * sizeof(float));
+      std::uint8_t* out = packet_.data() + data;
       for (int y = y0; y < y0 + h; ++y)
         for (int x = x0; x < x0 + w; ++x) {
           const int p = y * film.width + x;
           const Rgb m = film.mean(p);  // as to_image converts it
-          for (int c = 0; c < 3; ++c) tile.put(static_cast<float>(m[c]));
+          const float rgb[3] = {float(m[0]), float(m[1]), float(m[2])};
+          std::memcpy(out, rgb, sizeof rgb);
+          out += sizeof rgb;
           sent_samples_[size_t(p)] = film.samples[size_t(p)];
         }
       if (!send_all(tile.done())) return;
