@@ -2,7 +2,7 @@
 // index-matched medium objects: N spherical puffs of radius 0.25 at a fixed number density,
 // so that a point has the same few puffs around it whatever N (the region grows with N). Run:
 //   build/media_lookup --benchmark_filter=Lookup
-// Counters: lookups per second and the puffs present per lookup.
+// Counters: lookups per second, the puffs present per lookup and the objects its cell lists.
 
 #include <benchmark/benchmark.h>
 
@@ -84,11 +84,15 @@ void Lookup(benchmark::State& state) {
     present += m.mu_s.max() > 0 ? 1 : 0;
     benchmark::DoNotOptimize(m);
   }
-  size_t media = 0;
-  for (const Vec3& x : points) for_each_medium_at(p.scene, x, -1, [&](int, double) { ++media; });
+  size_t media = 0, listed = 0;
+  for (const Vec3& x : points) {
+    for_each_medium_at(p.scene, x, -1, [&](int, double) { ++media; });
+    listed += members_at(p.scene.field_grid, x).size();
+  }
   state.counters["lookups/s"] =
       benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["present"] = double(media) / double(points.size());
+  state.counters["listed"] = double(listed) / double(points.size());
   benchmark::DoNotOptimize(present);
 }
 

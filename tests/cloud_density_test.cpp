@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <memory>
 
 #include "nimbus/math/rng.h"
 
@@ -28,6 +29,32 @@ TEST(CloudDensity, ZeroWhereFIsNotPositiveAndWithinUnitInterval) {
   }
   EXPECT_EQ(cloud_density(cloud, {0.1, 0.2, 0.3}, 0.0), 0.0);
   EXPECT_EQ(cloud_density(cloud, {0.1, 0.2, 0.3}, -5.0), 0.0);
+}
+
+// The density with the noise computed afresh: a call at another point first replaces the
+// thread's last point, which cloud_density reuses at the same point of the same cloud.
+double fresh_density(const CloudNoise& cloud, const Vec3& x, double F) {
+  cloud_density(cloud, x + Vec3{1, 0, 0}, F);
+  return cloud_density(cloud, x, F);
+}
+
+TEST(CloudDensity, TheNoiseReusedAtAPointIsThatCloudsOwn) {
+  Rng rng(7);
+  for (int i = 0; i < 500; ++i) {
+    // Two clouds at one point, one after another, as overlapping puffs of two media are looked
+    // up; then a cloud made where the first was (a scene reloaded): none gets another's noise.
+    const Vec3 x = random_point(rng, 1);
+    const double F1 = 0.1 * rng.uniform(), F2 = 0.1 * rng.uniform();
+    auto a = std::make_unique<CloudNoise>(make_cloud_noise({.amplitude = 0.8, .seed = 1}));
+    const CloudNoise b = make_cloud_noise({.amplitude = 0.8, .seed = 2});
+    const double a1 = fresh_density(*a, x, F1), a2 = fresh_density(*a, x, F2);
+    const double b1 = fresh_density(b, x, F1);
+    EXPECT_EQ(cloud_density(*a, x, F1), a1);
+    EXPECT_EQ(cloud_density(b, x, F1), b1);
+    EXPECT_EQ(cloud_density(*a, x, F2), a2);
+    *a = make_cloud_noise({.amplitude = 0.8, .seed = 2});
+    EXPECT_EQ(cloud_density(*a, x, F1), b1);
+  }
 }
 
 TEST(CloudDensity, NonDecreasingInF) {

@@ -34,6 +34,22 @@ struct EveryObject {
 
 constexpr double kRegion = 4;  // puffs fill [0, 4]² × [0, 1]
 
+struct Puff {
+  Vec3 centre;
+  double radius;
+};
+
+// The puffs of the scenes below.
+std::vector<Puff> puff_list(int count) {
+  std::vector<Puff> list;
+  Rng rng(11);
+  for (int i = 0; i < count; ++i) {
+    const Vec3 c{kRegion * rng.uniform(), kRegion * rng.uniform(), rng.uniform()};
+    list.push_back({c, 0.1 + 0.2 * rng.uniform()});
+  }
+  return list;
+}
+
 // `count` spherical puffs of radius 0.1 to 0.3 sharing three media: constant (g 0), cloud
 // (g 0.85) and constant again (g 0.3); a point has about 20 of them around it.
 Scene puffs(int count, int octree_depth) {
@@ -51,12 +67,11 @@ Scene puffs(int count, int octree_depth) {
   smoke.g = 0.3;
   smoke.emission = Rgb({0.5, 0.1, 0.0});
   scene.media = {fog, cloud, smoke};
-  Rng rng(11);
-  for (int i = 0; i < count; ++i) {
-    const Vec3 c{kRegion * rng.uniform(), kRegion * rng.uniform(), rng.uniform()};
-    scene.objects.push_back(test::object_of(
-        make_shape(QuadricNode{sphere(c, 0.1 + 0.2 * rng.uniform())}), Surface::Type::None, i % 3));
-  }
+  const std::vector<Puff> list = puff_list(count);
+  for (int i = 0; i < count; ++i)
+    scene.objects.push_back(
+        test::object_of(make_shape(QuadricNode{sphere(list[i].centre, list[i].radius)}),
+                        Surface::Type::None, i % 3));
   finish_scene(scene);
   return scene;
 }
@@ -91,6 +106,32 @@ TEST(ManyMedia, PointLookupsEqualTheLoopOverEveryObjectToTheBit) {
   EXPECT_GT(crowded, 500);  // measured: 1 124
   // A lookup looks at a few dozen objects, not three thousand.
   EXPECT_LT(double(listed) / 20000, 150.0);
+}
+
+// The grid leaves a sphere out of the cells where its function is negative throughout (by an
+// interval bound with a margin over rounding): points on and within 1e-9 of the spheres'
+// surfaces, where F is about 0, still find exactly what the loop finds.
+TEST(ManyMedia, LookupsAtTheSurfacesOfPuffsEqualTheLoopToTheBit) {
+  const int count = 3000;
+  const Scene scene = puffs(count, 6);
+  const EveryObject every{scene.media, scene.objects, scene.field_objects};
+  PathSpectra<3> ps;
+  prepare_path_spectra(ps, scene, 0.0);
+  const std::vector<Puff> list = puff_list(count);
+  Rng rng(4);
+  for (int k = 0; k < 4000; ++k) {
+    const Puff& p = list[std::min(count - 1, int(rng.uniform() * count))];
+    const double z = 2 * rng.uniform() - 1, phi = 2 * kPi * rng.uniform();
+    const Vec3 u{std::sqrt(1 - z * z) * std::cos(phi), std::sqrt(1 - z * z) * std::sin(phi), z};
+    for (const double d : {-1e-9, -1e-13, -1e-16, 0.0, 1e-16, 1e-13, 1e-9}) {
+      const Vec3 x = p.centre + u * (p.radius * (1 + d));
+      const MediumPoint<3> fast = medium_at(scene, ps.media, x, -1);
+      const MediumPoint<3> loop = medium_at(every, ps.media, x, -1);
+      ASSERT_EQ(fast.mu_a, loop.mu_a) << "point " << k << " at " << d;
+      ASSERT_EQ(fast.mu_s, loop.mu_s) << "point " << k << " at " << d;
+      ASSERT_EQ(fast.mu_a_Le, loop.mu_a_Le) << "point " << k << " at " << d;
+    }
+  }
 }
 
 TEST(ManyMedia, MediaOfOneAnisotropyShareALobeOfTheMixture) {

@@ -1,6 +1,7 @@
 #include "nimbus/media/cloud_density.h"
 
 #include <algorithm>
+#include <atomic>
 
 namespace nimbus {
 namespace {
@@ -24,7 +25,8 @@ double noise01(double n) {
 }  // namespace
 
 CloudNoise make_cloud_noise(const CloudParams& params) {
-  return {params, make_noise(params.seed)};
+  static std::atomic<std::uint64_t> made{0};
+  return {params, make_noise(params.seed), ++made};
 }
 
 DensityPtr make_cloud_density(const CloudParams& params) {
@@ -37,12 +39,23 @@ double cloud_density(const CloudNoise& cloud, const Vec3& x, double F) {
   if (s <= 0) return 0;
   // In the core (F >= edge) d = (1 − E)/(1 − E) = 1 exactly, whatever the noise: skip it.
   if (s >= 1) return 1;
-  const Vec3 q = p.frequency * x;
-  const Vec3 warp{fbm(cloud.noise, q + kWarpOffset[0], kCloudWarpOctaves),
-                  fbm(cloud.noise, q + kWarpOffset[1], kCloudWarpOctaves),
-                  fbm(cloud.noise, q + kWarpOffset[2], kCloudWarpOctaves)};
-  const double nu = noise01(fbm(cloud.noise, q + kCloudWarp * warp, p.octaves));
-  return eroded(s, p.amplitude * (1 - nu));
+  // The noise does not depend on F: overlapping puffs of one cloud medium, looked up at one point
+  // one after another (medium_field.h), share the last point's, per thread (issue 26). Plain
+  // zero-initialised thread-locals: no initialisation guard on the hot path.
+  thread_local std::uint64_t last_id = 0;
+  thread_local double last_x = 0, last_y = 0, last_z = 0, last_nu = 0;
+  if (last_id != cloud.id || !(last_x == x.x && last_y == x.y && last_z == x.z)) {
+    const Vec3 q = p.frequency * x;
+    const Vec3 warp{fbm(cloud.noise, q + kWarpOffset[0], kCloudWarpOctaves),
+                    fbm(cloud.noise, q + kWarpOffset[1], kCloudWarpOctaves),
+                    fbm(cloud.noise, q + kWarpOffset[2], kCloudWarpOctaves)};
+    last_nu = noise01(fbm(cloud.noise, q + kCloudWarp * warp, p.octaves));
+    last_id = cloud.id;
+    last_x = x.x;
+    last_y = x.y;
+    last_z = x.z;
+  }
+  return eroded(s, p.amplitude * (1 - last_nu));
 }
 
 std::pair<double, double> cloud_density_range(double F_lo, double F_hi, const CloudParams& p) {

@@ -45,6 +45,7 @@ inline constexpr int kCloudWarpOctaves = 2;
 struct CloudNoise {
   CloudParams params;
   Noise noise;
+  std::uint64_t id = 0;  // unique to each make_cloud_noise (copies share it): keys the memo below
 };
 
 CloudNoise make_cloud_noise(const CloudParams& params);
