@@ -94,7 +94,16 @@ const char* signal_name(int sig) {
 }
 
 // One line, redrawn: what is being done, a bar, the fraction, the time so far and the ETA.
+// Whether a progress bar's line is open (drawn after a \r, not yet ended): a warning ends it
+// first, and a render without a bar (-q, or stderr not a terminal) prints no empty lines.
+std::atomic<bool> g_bar_open{false};
+
+void end_bar_line() {
+  if (g_bar_open.exchange(false)) std::fprintf(stderr, "\n");
+}
+
 void print_progress(const char* what, double fraction, double elapsed) {
+  g_bar_open = true;
   const int width = 40, filled = static_cast<int>(fraction * width);
   const double eta = fraction > 0 ? elapsed * (1 - fraction) / fraction : 0;
   std::fprintf(stderr, "\r%-8s [%s%s] %5.1f%%  %6.1fs elapsed  ETA %6.1fs", what,
@@ -122,7 +131,7 @@ std::function<void(double)> objects_bar() {
     if (!drawn && elapsed < 0.5) return;
     drawn = true;
     print_progress("objects", f, elapsed);
-    if (f >= 1) std::fprintf(stderr, "\n");
+    if (f >= 1) end_bar_line();
   };
 }
 
@@ -191,7 +200,8 @@ nimbus::RenderJobOptions job_options(const RenderArgs& args) {
   o.resume = args.resume;
   o.cancel = [] { return g_signal.load() != 0; };
   o.warning = [](const std::string& w) {
-    std::fprintf(stderr, "\nnimbus: warning: %s\n", nimbus::printable_line(w).c_str());
+    end_bar_line();
+    std::fprintf(stderr, "nimbus: warning: %s\n", nimbus::printable_line(w).c_str());
   };
   return o;
 }
@@ -410,7 +420,7 @@ int run_render(const RenderArgs& args, const Cluster& cluster) {
   }
   bool compiled = false;
   step = attempt([&] { compiled = job.compile(monitor); });
-  if (show_progress) std::fprintf(stderr, "\n");
+  end_bar_line();
   if (step.code == 0 && !compiled) {
     const int sig = g_signal.load();
     step = {128 + sig, fmt::format("nimbus: stopped by {} while compiling the scene; "
@@ -437,7 +447,7 @@ int run_render(const RenderArgs& args, const Cluster& cluster) {
   }
   const JobOutcome r = job.run(cluster.mpi ? &channel : nullptr);
   if (display) display->finish(r.film);
-  if (show_progress) std::fprintf(stderr, "\n");
+  end_bar_line();
   const int code = finish_render(args, job, outputs, r);
   send_exit_code(cluster, code);
   return code;
@@ -660,12 +670,12 @@ int run_export_vdb(const ExportArgs& args) {
   try {
     result = export_vdb(scene, object, args.voxel_size, args.output, monitor);
   } catch (const std::invalid_argument& e) {
-    if (show_progress) std::fprintf(stderr, "\n");
+    end_bar_line();
     std::fprintf(stderr, "nimbus: %s\n", e.what());
     return kExitBadInput;
   }
   g_writing = false;
-  if (show_progress) std::fprintf(stderr, "\n");
+  end_bar_line();
   if (result.cancelled) {
     const int sig = g_signal.load();
     std::fprintf(stderr, "nimbus: stopped by %s while building the grid; nothing written\n",

@@ -98,6 +98,7 @@ def assert_one_warning(err, about):
     warnings = [line for line in err.splitlines() if "warning" in line]
     assert len(warnings) == 1 and about in warnings[0], err
     assert warnings[0].startswith("nimbus: warning: --display-server 127.0.0.1:"), err
+    assert "" not in err.splitlines(), err  # no empty line before it where no bar was drawn
 
 
 def render_to(viewer, tmp_path, **kwargs):
