@@ -32,11 +32,12 @@ std::size_t member_grid_max_bytes(std::size_t objects) {
   if (objects == 0) return sizeof(MemberGrid);
   const double cells = kMemberGridMaxCellsPerTarget * kMemberGridCellsPerObject * double(objects);
   const double entries = double(member_grid_max_entries(objects));
-  // The cells' offsets twice (the count being filled, and the grid's copy), the entries, and
-  // the objects' bounds and quadrics.
+  // The cells' offsets twice (the count being filled, and the grid's copy), the entries, the
+  // objects' records, media and flags, and the bounds and quadrics they are built from.
   return sizeof(MemberGrid) +
          std::size_t(2 * (cells + 1) * sizeof(std::uint32_t) + entries * sizeof(std::int32_t)) +
-         objects * (sizeof(Box) + sizeof(GridQuadric));
+         objects *
+             (sizeof(GridObject) + sizeof(std::int32_t) + 1 + sizeof(Box) + sizeof(GridQuadric));
 }
 
 GridQuadric grid_quadric(const Tape& tape, int medium) {
@@ -50,10 +51,16 @@ GridQuadric grid_quadric(const Tape& tape, int medium) {
   return g;
 }
 
-MemberGrid build_member_grid(std::span<const Box> bounds, std::vector<GridQuadric> quadrics) {
+MemberGrid build_member_grid(std::span<const Box> bounds, std::span<const GridQuadric> quadrics) {
   MemberGrid grid;
-  grid.bounds.assign(bounds.begin(), bounds.end());
-  grid.quadrics = std::move(quadrics);
+  grid.objects.resize(bounds.size());
+  grid.medium.resize(bounds.size());
+  grid.single.resize(bounds.size());
+  for (std::size_t i = 0; i < bounds.size(); ++i) {
+    grid.objects[i] = {bounds[i], quadrics[i].quadric};
+    grid.medium[i] = quadrics[i].medium;
+    grid.single[i] = quadrics[i].single;
+  }
   for (const Box& b : bounds) grid.box = unite(grid.box, b);
   if (grid.box.empty()) return grid;
   double target = std::max(1.0, kMemberGridCellsPerObject * double(bounds.size()));

@@ -37,19 +37,28 @@ struct GridQuadric {
   bool single = false;  // false: evaluate the object's tape
 };
 
+// Object i's bounds and, where it is one quadric, its function, in two cache lines: a lookup
+// tests the box and evaluates the quadric from one record.
+struct alignas(64) GridObject {
+  Box bounds;
+  Quadric quadric;  // where single
+};
+static_assert(sizeof(GridObject) == 128);
+
 struct MemberGrid {
   Box box;  // the union of the objects' bounds; empty: no objects
   std::array<int, 3> cells{0, 0, 0};
   Vec3 inv_cell{0, 0, 0};            // cells per unit length, per axis
   std::vector<std::uint32_t> begin;  // cell c's objects: members[begin[c], begin[c + 1])
   std::vector<std::int32_t> members;
-  std::vector<Box> bounds;  // object i's bounds, together: a lookup tests them before the objects
-  std::vector<GridQuadric> quadrics;  // object i's single quadric, if it is one
+  std::vector<GridObject> objects;
+  std::vector<std::int32_t> medium;  // object i's medium
+  std::vector<std::uint8_t> single;  // whether object i is its quadric
 
   std::size_t bytes() const {
     return sizeof(MemberGrid) + begin.size() * sizeof(std::uint32_t) +
-           members.size() * sizeof(std::int32_t) + bounds.size() * sizeof(Box) +
-           quadrics.size() * sizeof(GridQuadric);
+           members.size() * sizeof(std::int32_t) + objects.size() * sizeof(GridObject) +
+           medium.size() * sizeof(std::int32_t) + single.size();
   }
   // The cell along axis k of coordinate v, clamped into the grid. Monotonic in v, so the
   // cells of an object's bounds hold every point inside them.
@@ -60,7 +69,7 @@ struct MemberGrid {
 };
 
 // The grid over `bounds` (object i's conservative bounds), with each object's `quadrics`.
-MemberGrid build_member_grid(std::span<const Box> bounds, std::vector<GridQuadric> quadrics);
+MemberGrid build_member_grid(std::span<const Box> bounds, std::span<const GridQuadric> quadrics);
 
 // What a grid keeps of an object whose function is `tape` and whose medium is `medium`.
 GridQuadric grid_quadric(const Tape& tape, int medium);

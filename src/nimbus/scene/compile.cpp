@@ -249,7 +249,7 @@ void finish_scene(Scene& scene, const BuildMonitor& monitor) {
     field_bounds.push_back(scene.objects[i].bounds);
     field_quadrics.push_back(grid_quadric(scene.objects[i].tape, scene.objects[i].medium));
   }
-  scene.field_grid = build_member_grid(field_bounds, std::move(field_quadrics));
+  scene.field_grid = build_member_grid(field_bounds, field_quadrics);
   if (!all.empty()) scene.scale = length(all.extent());
   scene.surfaces = build_surface_index(scene.objects, scene.lights);
   complete_spectra(scene);
