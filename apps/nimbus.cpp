@@ -428,6 +428,8 @@ int run_render(const RenderArgs& args, const Cluster& cluster) {
                                    signal_name(sig))};
   }
   if (const int code = agree(cluster, step); code != 0) return code;
+  if (lead)  // every rank compiles the same scene: one warning each, from the lead
+    for (const std::string& w : job.scene().warnings) options.warning(w);
   const uint64_t mine = majorant_hash(job.scene()), first = cluster_broadcast(mine);
   if (mine != first)
     step = {kExitFailure, fmt::format("built majorant octrees that differ from rank 0's (hash "

@@ -157,6 +157,12 @@ void run_interruptible(const std::function<void(const std::atomic<bool>& stop)>&
   if (!progress.is_none()) progress(1.0);
 }
 
+// The scene's compile warnings (an empty object left out) as UserWarning; the GIL held.
+void warn_of(const Scene& scene) {
+  for (const std::string& w : scene.warnings)
+    if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) throw py::error_already_set();
+}
+
 // A render job as `nimbus render` runs it. Returns the image and the --stats JSON text.
 py::tuple render(const PyScene& scene, int spp, std::optional<uint64_t> seed, int threads,
                  const py::object& progress) {
@@ -178,6 +184,7 @@ py::tuple render(const PyScene& scene, int spp, std::optional<uint64_t> seed, in
         if (compiled && !stopped) outcome = job.run();
       },
       fraction, stop, progress);
+  if (compiled) warn_of(job.scene());
   if (!compiled || outcome.stopped) throw std::runtime_error("the render was stopped");
   return py::make_tuple(to_array(to_image(outcome.film)), job.stats(outcome).dump());
 }
@@ -194,6 +201,7 @@ std::shared_ptr<const Scene> compiled_scene(const PyScene& scene, std::optional<
     py::gil_scoped_release release;
     compiled = std::make_shared<const Scene>(compile_scene(desc));
   }
+  warn_of(*compiled);
   cache = {seed, compiled};
   return compiled;
 }

@@ -446,6 +446,26 @@ std::vector<BadScene> bad_scenes() {
   };
 }
 
+// An object whose shape is empty (no point has F > 0) cannot be seen: it is left out, and the
+// scene says so in one line naming the object, which the command line prints as a warning.
+TEST(SceneCompile, AnEmptyShapeIsLeftOutWithAWarningNamingTheObject) {
+  const std::string shapes =
+      R"("shapes": {"a": {"type": "sphere", "center": [0, 0, 0], "radius": 1},
+                    "b": {"type": "sphere", "center": [5, 0, 0], "radius": 1},
+                    "e": {"type": "intersection", "shapes": ["a", "b"]}}, )";
+  const Scene seen = compile_scene(
+      load_scene_text(with_camera(shapes + R"("objects": [{"shape": "a"}])"), "scene.json"));
+  EXPECT_EQ(seen.objects.size(), 1u);
+  EXPECT_TRUE(seen.warnings.empty());
+  const Scene scene = compile_scene(load_scene_text(
+      with_camera(shapes + R"("objects": [{"shape": "a"}, {"shape": "e"}])"), "scene.json"));
+  EXPECT_EQ(scene.objects.size(), 1u);
+  ASSERT_EQ(scene.warnings.size(), 1u);
+  EXPECT_EQ(scene.warnings[0],
+            "scene.json: /objects/1/shape: shape \"e\" is empty (its function is positive "
+            "nowhere); the object is not rendered");
+}
+
 TEST(SceneLoad, MalformedScenesGiveOneLineErrorsNamingThePath) {
   const std::vector<BadScene> cases = bad_scenes();
   EXPECT_GE(cases.size(), 25u);

@@ -75,6 +75,24 @@ def test_errors_are_the_command_lines_line(tmp_path):
         nimbus.load_dict({"camera": float("nan")})
 
 
+def test_an_empty_shape_is_a_warning_from_both(tmp_path):
+    document = {"camera": {"from": [0, 0, 5], "to": [0, 0, 0]}, "film": {"width": 8, "height": 8},
+                "shapes": {"a": {"type": "sphere", "center": [0, 0, 0], "radius": 1},
+                           "b": {"type": "sphere", "center": [5, 0, 0], "radius": 1},
+                           "e": {"type": "intersection", "shapes": ["a", "b"]}},
+                "objects": [{"shape": "a"}, {"shape": "e"}]}
+    scene = tmp_path / "empty.json"
+    scene.write_text(json.dumps(document))
+    cli = subprocess.run([EXE, "render", str(scene), "-o", str(tmp_path / "x.exr"), "-q",
+                          "--spp", "1"], capture_output=True, text=True)
+    assert cli.returncode == 0
+    line = (f'nimbus: warning: {scene}: /objects/1/shape: shape "e" is empty (its function is '
+            'positive nowhere); the object is not rendered')
+    assert cli.stderr.splitlines() == [line]
+    with pytest.warns(UserWarning, match=r'^<dict>: /objects/1/shape: shape "e" is empty'):
+        nimbus.render(nimbus.load_dict(document), spp=1)
+
+
 def test_bad_arguments_raise_value_or_type_errors():
     scene = nimbus.load_file(DEMO, SMALL)
     for spp in (0, -1):

@@ -114,6 +114,9 @@ struct Scene {
   double scale = 1;                     // size of the scene's bounds, for ray offsets
   // The exponent of its films (film.h: film_exponent of brightest_emission; finish_scene).
   int film_exponent = 0;
+  // What compile_scene left out and why, one line each (an object whose shape is empty): the
+  // command line prints them as warnings, the Python module raises them as UserWarning.
+  std::vector<std::string> warnings;
 };
 
 struct SurfaceHit {

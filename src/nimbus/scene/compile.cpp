@@ -163,6 +163,7 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
   for (std::size_t k = 0; k < desc.objects.size(); ++k) {
     const ObjectDesc& od = desc.objects[k];
     const int medium = compiled_medium(od);
+    std::size_t empty = 0;  // copies whose shape is empty
     for (std::size_t i = first[k]; i < first[k + 1]; ++i) {
       if (failed[i]) std::rethrow_exception(failed[i]);
       SceneObject obj;
@@ -180,7 +181,10 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
         throw SceneError(fmt::format(
             "{}: {}/shape: shape \"{}\" is unbounded; clip it with an intersection (e.g. a box)",
             desc.source, od.json_path, od.shape_name));
-      if (b.box.empty()) continue;  // nothing is inside: the object cannot be seen
+      if (b.box.empty()) {  // nothing is inside: the object cannot be seen
+        ++empty;
+        continue;
+      }
       obj.bounds = b.box;
       obj.surface = compile_surface(od.surface);
       obj.medium = medium;
@@ -198,6 +202,12 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
       }
       scene.objects.push_back(std::move(obj));
     }
+    if (empty > 0)
+      scene.warnings.push_back(fmt::format(
+          "{}: {}/shape: shape \"{}\" is empty (its function is positive nowhere); {} not "
+          "rendered",
+          desc.source, od.json_path, od.shape_name,
+          od.instances ? fmt::format("its {} instances are", empty) : "the object is"));
   }
   // Their moved-from husks (264 bytes a copy) would stay through the octrees' build.
   std::vector<Tape>().swap(tapes);
