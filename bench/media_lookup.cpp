@@ -109,8 +109,8 @@ BENCHMARK(Lookup)->ArgsProduct({{4, 64, 1024, 10000}, {0, 1}, {0, 1, 2}});
 
 // This machine's latency of a load whose address comes from the last load, in a working set of
 // state.range(0) KiB visited in random order: the floor under a lookup whose cell list and
-// objects are not in cache, for it takes two such loads, one after the other, to reach an
-// object from a point (the cell's offset, then its list).
+// objects are not in cache, for it takes three such loads, one after the other, to reach an
+// object from a point (the cell's offset, its list, the object's record).
 void DependentLoad(benchmark::State& state) {
   const std::size_t lines = std::size_t(state.range(0)) * 1024 / 64;
   std::vector<std::size_t> order(lines);

@@ -464,6 +464,19 @@ TEST(SceneCompile, AnEmptyShapeIsLeftOutWithAWarningNamingTheObject) {
   EXPECT_EQ(scene.warnings[0],
             "scene.json: /objects/1/shape: shape \"e\" is empty (its function is positive "
             "nowhere); the object is not rendered");
+  // Instances of an empty shape are all empty; ten empty objects are eight lines and a count.
+  std::string many = R"("objects": [{"shape": "e", "instances": [[{"scale": 2}], [{"scale": 3}]]})";
+  for (int i = 0; i < 10; ++i) many += R"(, {"shape": "e"})";
+  const Scene crowd =
+      compile_scene(load_scene_text(with_camera(shapes + many + "]"), "scene.json"));
+  EXPECT_TRUE(crowd.objects.empty());
+  ASSERT_EQ(crowd.warnings.size(), 9u);
+  EXPECT_EQ(crowd.warnings[0],
+            "scene.json: /objects/0/shape: shape \"e\" is empty (its function is positive "
+            "nowhere); its 2 instances are not rendered");
+  EXPECT_EQ(crowd.warnings[7].substr(0, 34), "scene.json: /objects/7/shape: shap");
+  EXPECT_EQ(crowd.warnings[8],
+            "scene.json: 3 more objects whose shapes are empty are not rendered");
 }
 
 TEST(SceneLoad, MalformedScenesGiveOneLineErrorsNamingThePath) {

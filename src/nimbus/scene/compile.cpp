@@ -160,6 +160,9 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
   unplaced.clear();
   std::vector<double> field_g;    // the different anisotropies of index-matched media
   scene.objects.reserve(copies);  // growing it would hold two copies of 10^6 objects at once
+  // Objects with an empty shape: the first few are named, the rest counted in one line.
+  constexpr std::size_t kEmptyObjectWarnings = 8;
+  std::size_t empty_objects = 0;
   for (std::size_t k = 0; k < desc.objects.size(); ++k) {
     const ObjectDesc& od = desc.objects[k];
     const int medium = compiled_medium(od);
@@ -202,13 +205,17 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
       }
       scene.objects.push_back(std::move(obj));
     }
-    if (empty > 0)
+    if (empty > 0 && ++empty_objects <= kEmptyObjectWarnings)
       scene.warnings.push_back(fmt::format(
           "{}: {}/shape: shape \"{}\" is empty (its function is positive nowhere); {} not "
           "rendered",
           desc.source, od.json_path, od.shape_name,
           od.instances ? fmt::format("its {} instances are", empty) : "the object is"));
   }
+  if (empty_objects > kEmptyObjectWarnings)
+    scene.warnings.push_back(
+        fmt::format("{}: {} more objects whose shapes are empty are not rendered", desc.source,
+                    empty_objects - kEmptyObjectWarnings));
   // Their moved-from husks (264 bytes a copy) would stay through the octrees' build.
   std::vector<Tape>().swap(tapes);
   std::vector<std::exception_ptr>().swap(failed);
