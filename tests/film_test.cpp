@@ -284,14 +284,16 @@ TEST(Film, RoundTripsThroughAFile) {
     return std::string("no error");
   };
   EXPECT_EQ(message((dir / "missing.film").string()),
-            (dir / "missing.film").string() + ": cannot open the film file");
+            (dir / "missing.film").string() + ": cannot open file (No such file or directory)");
   const std::string bad = (dir / "bad.film").string();
   std::ofstream(bad) << "{\"not\": \"a film\"}";
   EXPECT_EQ(message(bad), bad + ": not a nimbus film file");
   const auto size = std::filesystem::file_size(path);
   std::filesystem::copy_file(path, bad, std::filesystem::copy_options::overwrite_existing);
   std::filesystem::resize_file(bad, size - 1);
-  EXPECT_EQ(message(bad), bad + ": the film file is cut short");
+  EXPECT_EQ(message(bad), bad +
+                              ": the film file is damaged or cut short (its header claims 37x23 "
+                              "pixels, 64676 bytes, and 64675 follow)");
   std::filesystem::copy_file(path, bad, std::filesystem::copy_options::overwrite_existing);
   std::ofstream(bad, std::ios::app) << 'x';
   EXPECT_EQ(message(bad), bad + ": trailing bytes after the film");

@@ -3,20 +3,50 @@
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
+#include <ImfIO.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfStandardAttributes.h>
+#include <fmt/format.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <stdexcept>
 #include <string_view>
 
 #include "nimbus/io/atomic_file.h"
+#include "nimbus/os/regular_file.h"
+#include "nimbus/render/memory_estimate.h"
 
 namespace nimbus {
 namespace {
 
 constexpr const char* kChannels[3] = {"R", "G", "B"};
+
+// OpenEXR reads through the regular file nimbus opened (os/regular_file.h), so that a FIFO or a
+// device is refused before the library sees it, and the file read is the file checked.
+class ExrInput : public Imf::IStream {
+ public:
+  explicit ExrInput(RegularFile& file) : Imf::IStream(file.path().c_str()), file_(file) {}
+  bool read(char c[], int n) override {
+    std::istream& in = file_.stream();
+    in.read(c, n);
+    if (in.gcount() != n) throw std::runtime_error("unexpected end of file");
+    at_ += uint64_t(n);
+    return at_ < file_.size();
+  }
+  uint64_t tellg() override { return at_; }
+  void seekg(uint64_t pos) override {
+    file_.stream().clear();
+    file_.stream().seekg(std::streamoff(pos));
+    at_ = pos;
+  }
+  void clear() override { file_.stream().clear(); }
+
+ private:
+  RegularFile& file_;
+  uint64_t at_ = 0;
+};
 
 }  // namespace
 
@@ -53,12 +83,29 @@ void write_exr(const std::string& path, const Image& image) {
 }
 
 Image read_exr(const std::string& path) {
+  RegularFile input(path);  // FileOpenError, "PATH: not a regular file (a FIFO)", as it is
   try {
-    Imf::InputFile file(path.c_str());
+    ExrInput stream(input);
+    Imf::InputFile file(stream);
     const Imath::Box2i window = file.header().dataWindow();
+    // The size its header claims, checked before it is allocated: a few bytes of header may claim
+    // more pixels than memory holds (a compressed file's length does not bound its pixels).
+    const int64_t w = int64_t(window.max.x) - window.min.x + 1;
+    const int64_t h = int64_t(window.max.y) - window.min.y + 1;
+    if (w <= 0 || h <= 0 || w > 1 << 20 || h > 1 << 20)
+      throw std::runtime_error(fmt::format("a data window of {}x{} pixels", w, h));
+    int channels = 0;
+    for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it)
+      ++channels;
+    const uint64_t need = uint64_t(w) * uint64_t(h) * uint64_t(std::max(channels, 3)) * 4;
+    if (const uint64_t free = available_memory(); free != 0 && need > free)
+      throw std::runtime_error(
+          fmt::format("an image of {}x{} pixels in {} channels needs {}; {} "
+                      "is available",
+                      w, h, channels, format_memory(double(need)), format_memory(double(free))));
     Image image;
-    image.width = window.max.x - window.min.x + 1;
-    image.height = window.max.y - window.min.y + 1;
+    image.width = int(w);
+    image.height = int(h);
     const size_t pixels = static_cast<size_t>(image.width) * image.height;
     image.rgb.assign(3 * pixels, 0.0f);
     Imf::FrameBuffer frame;

@@ -2,12 +2,15 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
 #include <fstream>
 #include <stdexcept>
 
 #include "nimbus/io/atomic_file.h"
+#include "nimbus/os/regular_file.h"
+#include "nimbus/render/memory_estimate.h"
 
 namespace nimbus {
 
@@ -18,6 +21,15 @@ constexpr char kFilmMagic[8] = {'N', 'I', 'M', 'F', 'I', 'L', 'M', '\0'};
 // AOV sums (earlier versions read as a film without them).
 constexpr uint32_t kFilmVersion = 4;
 static_assert(std::endian::native == std::endian::little, "film files are little endian");
+
+// The bytes a pixel takes in the file (and, as much again, in memory): its count and sums, and
+// the sums of each AOV layer.
+uint64_t film_bytes_per_pixel(AovSet aovs) {
+  const Film one(1, 1, 0, aovs, 0);
+  uint64_t bytes = sizeof one.samples[0] + 3 * sizeof one.sum[0].c[0] + 3 * sizeof one.sum_sq[0][0];
+  one.aov.for_each_vector([&](const auto& v) { bytes += v.size() * sizeof v[0]; });
+  return bytes;
+}
 
 }  // namespace
 
@@ -40,7 +52,8 @@ void write_film(std::ostream& out, const Film& film) {
   });
 }
 
-Film read_film(std::istream& in, const std::string& name) {
+Film read_film(std::istream& in, const std::string& name, uint64_t bytes) {
+  const uint64_t start = uint64_t(in.tellg());
   auto get = [&](auto& v) {
     in.read(reinterpret_cast<char*>(&v), sizeof v);
     if (!in) throw std::runtime_error(name + ": the film file is cut short");
@@ -75,6 +88,20 @@ Film read_film(std::istream& in, const std::string& name) {
     throw std::runtime_error(fmt::format("{}: a film of unknown AOV layers ({})", name, layers));
   if (depth_exponent < -1200 || depth_exponent > 1100)
     throw std::runtime_error(fmt::format("{}: a film of depth exponent {}", name, depth_exponent));
+  // The pixels' size from the header, checked before anything of that size is allocated (issue
+  // 44: 29 bytes claiming 4096 x 4096 pixels allocated 1.3 GB before saying "cut short").
+  const uint64_t pixels = uint64_t(w) * uint64_t(h);
+  const uint64_t need = pixels * film_bytes_per_pixel(aovs);
+  const uint64_t have = bytes - std::min(bytes, uint64_t(in.tellg()) - start);
+  if (need > have)
+    throw std::runtime_error(fmt::format(
+        "{}: the film file is damaged or cut short (its header claims {}x{} pixels, {} bytes, "
+        "and {} follow)",
+        name, w, h, need, have));
+  if (const uint64_t free = available_memory(); free != 0 && need > free)
+    throw std::runtime_error(fmt::format("{}: a film of {}x{} pixels needs {}; {} is available",
+                                         name, w, h, format_memory(double(need)),
+                                         format_memory(double(free))));
   Film film(w, h, exponent, aovs, depth_exponent);
   for (int p = 0; p < film.pixels(); ++p) {
     get(film.samples[p]);
@@ -98,9 +125,9 @@ void save_film(const Film& film, const std::string& path) {
 }
 
 Film load_film(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path + ": cannot open the film file");
-  Film film = read_film(in, path);
+  RegularFile file(path);  // a FIFO, a device or a directory is refused without blocking
+  std::istream& in = file.stream();
+  Film film = read_film(in, path, file.size());
   if (in.peek() != std::char_traits<char>::eof())
     throw std::runtime_error(path + ": trailing bytes after the film");
   return film;

@@ -4,13 +4,14 @@
 #include <zlib.h>
 
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <stdexcept>
 #include <vector>
 
 #include "nimbus/io/atomic_file.h"
 #include "nimbus/io/film_file.h"
+#include "nimbus/os/regular_file.h"
+#include "nimbus/scene/load.h"
 
 namespace nimbus {
 
@@ -22,9 +23,10 @@ constexpr char kMagic[8] = {'N', 'I', 'M', 'C', 'K', 'P', 'T', '\0'};
 constexpr uint32_t kVersion = 2;
 constexpr uint32_t kMaxFingerprintBytes = 64u << 20;  // a scene file's limit (scene/load.h)
 
-// zlib's CRC-32 of the first `length` bytes of the file.
-uint32_t crc32_of_file(const std::string& path, uint64_t length) {
-  std::ifstream in(path, std::ios::binary);
+// zlib's CRC-32 of the `length` bytes from the stream's start (the stream is left after them).
+uint32_t crc32_of(std::istream& in, uint64_t length, const std::string& path) {
+  in.clear();
+  in.seekg(0);
   std::vector<char> buffer(1 << 20);
   uLong crc = crc32_z(0, nullptr, 0);
   while (length > 0) {
@@ -54,7 +56,8 @@ void save_checkpoint(const Checkpoint& c, const std::string& path) {
     out.close();
     if (!out) throw std::runtime_error("cannot write the checkpoint");
     // The checksum of the bytes as the file holds them.
-    const uint32_t crc = crc32_of_file(temp, std::filesystem::file_size(temp));
+    RegularFile written(temp);
+    const uint32_t crc = crc32_of(written.stream(), written.size(), temp);
     std::ofstream tail(temp, std::ios::binary | std::ios::app);
     tail.write(reinterpret_cast<const char*>(&crc), sizeof crc);
     tail.close();
@@ -63,8 +66,8 @@ void save_checkpoint(const Checkpoint& c, const std::string& path) {
 }
 
 Checkpoint load_checkpoint(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path + ": cannot open the checkpoint");
+  RegularFile file(path);  // a FIFO, a device or a directory is refused without blocking
+  std::istream& in = file.stream();
   auto get = [&](auto& v) {
     in.read(reinterpret_cast<char*>(&v), sizeof v);
     if (!in) throw std::runtime_error(path + ": the checkpoint is cut short");
@@ -79,20 +82,20 @@ Checkpoint load_checkpoint(const std::string& path) {
     throw std::runtime_error(
         fmt::format("{}: checkpoint version {}, this nimbus reads {}", path, version, kVersion));
   // The checksum first: nothing of a damaged file is trusted, not even the film's size.
-  std::error_code ec;
-  const uint64_t bytes = std::filesystem::file_size(path, ec);
-  if (ec) throw std::runtime_error(path + ": the checkpoint is not a regular file");
+  const uint64_t bytes = file.size();
   uint32_t crc = 0;
   if (bytes < sizeof kMagic + sizeof version + sizeof crc)
     throw std::runtime_error(path + ": the checkpoint is cut short");
   const uint64_t covered = bytes - sizeof crc;
-  std::ifstream tail(path, std::ios::binary);
-  tail.seekg(std::streamoff(covered));
-  tail.read(reinterpret_cast<char*>(&crc), sizeof crc);
-  if (!tail || crc != crc32_of_file(path, covered))
+  in.seekg(std::streamoff(covered));
+  get(crc);
+  if (crc != crc32_of(in, covered, path))
     throw std::runtime_error(path +
                              ": the checkpoint is damaged or cut short (its checksum does not "
                              "match)");
+  // A file with the right checksum may still be made to harm its reader: every size in it is
+  // checked against the bytes that follow, and its JSON against the scene loader's limits.
+  in.seekg(std::streamoff(sizeof kMagic + sizeof version));
   Checkpoint c;
   int32_t spp = 0;
   get(spp);
@@ -100,14 +103,21 @@ Checkpoint load_checkpoint(const std::string& path) {
   get(c.majorants);
   uint32_t size = 0;
   get(size);
-  if (size > kMaxFingerprintBytes) throw std::runtime_error(path + ": not a nimbus checkpoint");
+  if (size > kMaxFingerprintBytes || size > covered - uint64_t(in.tellg()))
+    throw std::runtime_error(path + ": not a nimbus checkpoint (its fingerprint's size)");
   std::string fingerprint(size, '\0');
   in.read(fingerprint.data(), size);
   if (!in) throw std::runtime_error(path + ": the checkpoint is cut short");
-  c.fingerprint = nlohmann::json::parse(fingerprint, nullptr, false);
-  if (c.fingerprint.is_discarded() || spp < 1)
+  try {
+    // The scene's document sits one level down in the fingerprint (job/fingerprint.h).
+    c.fingerprint = parse_json_text(fingerprint, path + ": the fingerprint", kMaxJsonDepth + 1);
+  } catch (const SceneError& e) {
+    throw std::runtime_error(e.what());
+  }
+  if (!c.fingerprint.is_object() || spp < 1)
     throw std::runtime_error(path + ": not a nimbus checkpoint");
-  c.film = read_film(in, path);
+  const uint64_t film_at = uint64_t(in.tellg());
+  c.film = read_film(in, path, covered - film_at);
   if (uint64_t(in.tellg()) != covered)
     throw std::runtime_error(path + ": trailing bytes after the checkpoint");
   return c;

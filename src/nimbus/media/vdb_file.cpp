@@ -22,11 +22,13 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <vector>
 
 #include "nimbus/media/isolated_call.h"
 #include "nimbus/media/vdb_density.h"
+#include "nimbus/os/regular_file.h"
 
 namespace nimbus {
 namespace {
@@ -69,15 +71,13 @@ enum class Format { OpenVdb, NanoVdb };
 // Only a regular file that starts with either library's magic number is handed to a library: a
 // directory, a FIFO or a text file is one line here, and neither reader sees it.
 Format sniff(const std::string& file) {
-  std::error_code ec;
-  const fs::file_status st = fs::status(file, ec);
-  if (!fs::exists(st))
-    fail_file(file, fmt::format("cannot open file ({})",
-                                ec ? ec.message() : std::string("No such file or directory")));
-  if (fs::is_directory(st)) fail_file(file, "cannot open file (is a directory)");
-  if (!fs::is_regular_file(st)) fail_file(file, "not a regular file");
-  std::ifstream in(file, std::ios::binary);
-  if (!in) fail_file(file, fmt::format("cannot open file ({})", std::strerror(errno)));
+  std::optional<RegularFile> f;
+  try {
+    f.emplace(file);
+  } catch (const FileOpenError& e) {
+    fail_file(file, e.reason);
+  }
+  std::istream& in = f->stream();
   unsigned char head[8] = {};
   in.read(reinterpret_cast<char*>(head), sizeof head);
   const std::streamsize got = in.gcount();

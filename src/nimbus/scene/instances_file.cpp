@@ -7,10 +7,10 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
 #include <optional>
 #include <regex>
+
+#include "nimbus/os/regular_file.h"
 
 namespace nimbus {
 namespace {
@@ -64,15 +64,14 @@ std::string shape_text(const std::vector<std::size_t>& shape) {
 
 std::vector<Mat4> read_instances_file(const std::string& path) {
   static_assert(std::endian::native == std::endian::little, "reads little-endian data in place");
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (fs::is_directory(st)) throw InstancesFileError("cannot open file (is a directory)");
-  if (fs::exists(st) && !fs::is_regular_file(st)) throw InstancesFileError("not a regular file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InstancesFileError(fmt::format("cannot open file ({})", std::strerror(errno)));
-  const auto file_bytes = fs::file_size(path, ec);
-  if (ec) throw InstancesFileError("cannot read the file's size");
+  std::optional<RegularFile> file;
+  try {
+    file.emplace(path);
+  } catch (const FileOpenError& e) {
+    throw InstancesFileError(e.reason);
+  }
+  std::istream& in = file->stream();
+  const uint64_t file_bytes = file->size();
 
   std::array<char, 8> lead{};
   if (!in.read(lead.data(), lead.size()) || std::memcmp(lead.data(), kMagic, 6) != 0)

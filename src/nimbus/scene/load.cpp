@@ -4,11 +4,9 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <optional>
 #include <set>
@@ -17,6 +15,7 @@
 #include "nimbus/frep/primitives.h"
 #include "nimbus/frep/tape.h"
 #include "nimbus/media/octree.h"
+#include "nimbus/os/regular_file.h"
 #include "nimbus/render/scene.h"
 #include "nimbus/render/setting_names.h"
 #include "nimbus/render/settings.h"
@@ -581,31 +580,20 @@ class Loader {
 // The scene file's text: a regular file of at most kMaxSceneFileBytes, in UTF-8. Anything else
 // (a directory, a FIFO that would block, /dev/zero that never ends, a binary file) is one line.
 std::string read_file(const std::string& path) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (fs::is_directory(st)) throw SceneError(path + ": cannot open file (is a directory)");
-  if (fs::exists(st) && !fs::is_regular_file(st))
-    throw SceneError(path + ": not a regular file (" +
-                     (fs::is_fifo(st)             ? "a FIFO"
-                      : fs::is_character_file(st) ? "a character device"
-                      : fs::is_block_file(st)     ? "a block device"
-                      : fs::is_socket(st)         ? "a socket"
-                                                  : "not a file") +
-                     ")");
-  if (fs::exists(st)) {
-    const auto size = fs::file_size(path, ec);
-    if (!ec && size > kMaxSceneFileBytes)
+  try {
+    RegularFile file(path);
+    if (file.size() > kMaxSceneFileBytes)
       throw SceneError(fmt::format("{}: the file has {} bytes; a scene file may have at most {}",
-                                   path, size, kMaxSceneFileBytes));
+                                   path, file.size(), kMaxSceneFileBytes));
+    std::string text(file.size(), '\0');
+    file.stream().read(text.data(), std::streamsize(text.size()));
+    if (uint64_t(file.stream().gcount()) != file.size())
+      throw SceneError(fmt::format("{}: cannot read file (read {} of its {} bytes)", path,
+                                   file.stream().gcount(), file.size()));
+    return text;
+  } catch (const FileOpenError& e) {
+    throw SceneError(e.what());
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneError(fmt::format("{}: cannot open file ({})", path, std::strerror(errno)));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad())
-    throw SceneError(fmt::format("{}: cannot read file ({})", path, std::strerror(errno)));
-  return text.str();
 }
 
 }  // namespace
@@ -615,7 +603,8 @@ std::string read_file(const std::string& path) {
 // naming the JSON path; run before the text is parsed (parse_checked).
 class DuplicateKeys {
  public:
-  explicit DuplicateKeys(const std::string& source) : source_(source) {}
+  DuplicateKeys(const std::string& source, int max_depth = kMaxJsonDepth)
+      : source_(source), max_depth_(max_depth) {}
   // The pointer of the value the parser reads next (a number it could not hold, say).
   std::string next_value_pointer() const {
     if (frames_.empty()) return "/";
@@ -674,9 +663,9 @@ class DuplicateKeys {
     return true;
   }
   bool open(bool array) {
-    if (frames_.size() >= size_t(kMaxJsonDepth))
+    if (frames_.size() >= size_t(max_depth_))
       throw SceneError(fmt::format("{}: {}: arrays and objects nest deeper than {} levels", source_,
-                                   next_value_pointer_cut(), kMaxJsonDepth));
+                                   next_value_pointer_cut(), max_depth_));
     enter_element();
     frames_.push_back(
         {array, -1, {}, frames_.empty() ? "" : child_pointer(here(), key_or_index()), {}});
@@ -694,6 +683,7 @@ class DuplicateKeys {
     return f.array ? std::to_string(f.index) : f.key;
   }
   const std::string& source_;
+  int max_depth_;
   std::vector<Frame> frames_;
 };
 
@@ -811,17 +801,15 @@ SceneDesc load_scene_json(nlohmann::json j, const std::string& source,
   return load_json_in(std::move(j), source, "", overrides);
 }
 
-namespace {
-
 // The text must be UTF-8 (strictly: an overlong form or a surrogate is not) without NUL bytes,
 // which the JSON parser would take for the end of the input (issue 29).
-nlohmann::json parse_scene_text(const std::string& text, const std::string& source) {
+nlohmann::json parse_json_text(const std::string& text, const std::string& source, int max_depth) {
   if (const size_t at = invalid_utf8_at(text); at != std::string_view::npos)
     throw SceneError(fmt::format("{}: not UTF-8 text (byte {})", source, at));
   if (const size_t at = text.find('\0'); at != std::string::npos)
     throw SceneError(fmt::format("{}: a NUL byte at byte {} (a scene file is text)", source, at));
   nlohmann::json j;
-  DuplicateKeys keys(source);
+  DuplicateKeys keys(source, max_depth);
   try {
     j = parse_checked(text, keys, /*ignore_comments=*/true);
   } catch (const nlohmann::json::out_of_range& e) {
@@ -845,15 +833,13 @@ nlohmann::json parse_scene_text(const std::string& text, const std::string& sour
   return j;
 }
 
-}  // namespace
-
 SceneDesc load_scene_text(const std::string& text, const std::string& source,
                           const std::vector<std::string>& overrides) {
-  return load_json_in(parse_scene_text(text, source), source, "", overrides);
+  return load_json_in(parse_json_text(text, source), source, "", overrides);
 }
 
 SceneDesc load_scene_file(const std::string& path, const std::vector<std::string>& overrides) {
-  return load_json_in(parse_scene_text(read_file(path), path), path,
+  return load_json_in(parse_json_text(read_file(path), path), path,
                       std::filesystem::path(path).parent_path().string(), overrides);
 }
 

@@ -51,6 +51,13 @@ inline const Range kEmission = between(0, kMaxEmission);
 // weights of 1e50 speckled the surface, 1.7e308 made holes and NaN).
 inline constexpr double kMaxPerturbationWeight = 1e15;
 
+// JSON text parsed as a scene file is, with its limits (comments allowed; UTF-8 without NUL bytes;
+// no key twice in an object; at most `max_depth` levels; numbers within a double): every problem
+// is one SceneError, "SOURCE: problem" or "SOURCE: /json/pointer: problem". For any JSON nimbus
+// reads from outside (a checkpoint's fingerprint, the viewer's requests).
+nlohmann::json parse_json_text(const std::string& text, const std::string& source,
+                               int max_depth = kMaxJsonDepth);
+
 // Reads, parses and validates a scene file; every problem is one SceneError line naming the
 // file and, inside it, the JSON path.
 SceneDesc load_scene_file(const std::string& path, const std::vector<std::string>& overrides = {});
