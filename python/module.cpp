@@ -1,14 +1,14 @@
 // nimbus._core, the compiled part of the Python package nimbus (python/nimbus/__init__.py, which
 // checks the arguments and documents the API): scenes loaded as the command line loads them,
 // rendered by the same RenderJob into the pixels `nimbus render` writes, with the GIL released
-// while rendering and SIGINT turned into KeyboardInterrupt.
+// while rendering and SIGINT turned into KeyboardInterrupt. Paths are taken as Python's own
+// functions take them, and outputs follow the command line's rules (io/output.h).
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
-#include <pybind11/stl/filesystem.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -17,7 +17,9 @@
 #include <cmath>
 #include <condition_variable>
 #include <exception>
+#include <filesystem>
 #include <functional>
+#include <future>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -45,6 +47,76 @@ namespace nimbus_python {
 
 using namespace nimbus;
 
+// A path argument as open() takes one: a str, bytes or os.PathLike, encoded as the file system
+// wants; a NUL in it, at which the C library would cut the path short (issue 44: "scene.json\0junk"
+// loaded scene.json), is Python's "ValueError: embedded null byte".
+std::string path_of(const py::handle& arg) {
+  PyObject* bytes = nullptr;
+  if (PyUnicode_FSConverter(arg.ptr(), &bytes) == 0) throw py::error_already_set();
+  std::string path(PyBytes_AS_STRING(bytes), size_t(PyBytes_GET_SIZE(bytes)));
+  Py_DECREF(bytes);
+  return path;
+}
+
+// Calls f, whose std::runtime_error is a file that cannot be read or written: Python's OSError,
+// with the command line's line. The scene's and the job's errors keep their types.
+template <class F>
+auto os_errors(F&& f) {
+  try {
+    return f();
+  } catch (const SceneError&) {
+    throw;
+  } catch (const JobError&) {
+    throw;
+  } catch (const std::runtime_error& e) {
+    PyErr_SetString(PyExc_OSError, e.what());
+    throw py::error_already_set();
+  }
+}
+
+// The files that the scenes loaded in this process read: their scene files, instances files and,
+// once compiled, grids, as absolute paths. write_image and Film.save never replace one, as
+// `nimbus render` never replaces a file it reads. Kept for the process's life (a dropped scene's
+// file is often rendered again), one entry per path; used with the GIL held.
+std::vector<NamedFile>& files_read() {
+  static std::vector<NamedFile> files;
+  return files;
+}
+
+void remember_read(const std::vector<NamedFile>& read) {
+  std::vector<NamedFile>& files = files_read();
+  for (const NamedFile& f : read) {
+    std::error_code ec;
+    const std::filesystem::path absolute = std::filesystem::absolute(f.path, ec);
+    const std::string path = ec ? f.path : absolute.string();
+    if (std::none_of(files.begin(), files.end(),
+                     [&](const NamedFile& g) { return g.path == path; }))
+      files.push_back({f.what, path});
+  }
+}
+
+void remember_inputs(const std::vector<InputFile>& inputs) {
+  std::vector<NamedFile> read;
+  for (const InputFile& f : inputs) read.push_back({"the file of " + f.pointer, f.path});
+  remember_read(read);
+}
+
+// ValueError unless `path` may be written by `what` ("write_image"): the checks of
+// `nimbus render -o` (check_output_path for an image, else check_writable_path: the folder is
+// there and writable, not /dev, /proc or /sys, the path no directory, device or FIFO), and no
+// file a loaded scene reads.
+void check_output(const std::string& what, const std::string& path, bool image) {
+  try {
+    if (image)
+      check_output_path(path);
+    else
+      check_writable_path(path);
+    check_outputs_distinct({{what, path}}, files_read(), "a loaded scene");
+  } catch (const std::runtime_error& e) {
+    throw py::value_error(e.what());
+  }
+}
+
 // A loaded scene: what to load again for each render (a file with its overrides, or a document),
 // checked once at load time so that errors surface there.
 struct PyScene {
@@ -55,8 +127,12 @@ struct PyScene {
   int width = 0, height = 0, spp = 0;
   uint64_t seed = 0;
   // The scene compiled for a seed, for films and render_into: the last one asked for.
-  std::shared_ptr<std::pair<std::optional<uint64_t>, std::shared_ptr<const Scene>>> compiled =
-      std::make_shared<std::pair<std::optional<uint64_t>, std::shared_ptr<const Scene>>>();
+  struct Compiled {
+    std::optional<uint64_t> seed;
+    std::shared_future<std::shared_ptr<const Scene>> scene;  // valid: compiled, or compiling
+    uint64_t generation = 0;
+  };
+  std::shared_ptr<Compiled> compiled = std::make_shared<Compiled>();
 };
 
 // The description as a render loads it: the overrides, then the seed if one is given.
@@ -75,12 +151,17 @@ PyScene describe(const SceneDesc& desc, PyScene s) {
   return s;
 }
 
-PyScene load_file(const std::string& path, const std::vector<std::string>& overrides) {
-  return describe(load_scene_file(path, overrides), PyScene{path, {}, path, overrides});
+PyScene load_file(const py::object& path_arg, const std::vector<std::string>& overrides) {
+  const std::string path = path_of(path_arg);
+  const SceneDesc desc = load_scene_file(path, overrides);
+  remember_read({{"the scene file", path}});
+  remember_inputs(desc.inputs);
+  return describe(desc, PyScene{path, {}, path, overrides});
 }
 
 PyScene load_text(const std::string& text, const std::string& source) {
   SceneDesc desc = load_scene_text(text, source);
+  remember_inputs(desc.inputs);
   return describe(desc, PyScene{"", desc.document, source, {}});
 }
 
@@ -184,25 +265,43 @@ py::tuple render(const PyScene& scene, int spp, std::optional<uint64_t> seed, in
         if (compiled && !stopped) outcome = job.run();
       },
       fraction, stop, progress);
+  remember_read(job.files_read());
   if (compiled) warn_of(job.scene());
   if (!compiled || outcome.stopped) throw std::runtime_error("the render was stopped");
   return py::make_tuple(to_array(to_image(outcome.film)), job.stats(outcome).dump());
 }
 
 // The scene compiled for `seed` (its own when none), compiled once for the last seed asked. The
-// cache is read and written with the GIL held (other Python threads may render the same scene);
-// the compile itself runs without it.
+// cache is read and written with the GIL held; the compile runs without it. Threads that ask for
+// the seed being compiled wait for that compile (one compile, its warnings once); a compile that
+// fails is not kept, so the next call tries again.
 std::shared_ptr<const Scene> compiled_scene(const PyScene& scene, std::optional<uint64_t> seed) {
-  auto& cache = *scene.compiled;
-  if (cache.second && cache.first == seed) return cache.second;
-  const SceneDesc desc = reload(scene, seed);
-  std::shared_ptr<const Scene> compiled;
-  {
+  PyScene::Compiled& cache = *scene.compiled;
+  if (cache.scene.valid() && cache.seed == seed) {
+    const std::shared_future<std::shared_ptr<const Scene>> pending = cache.scene;
     py::gil_scoped_release release;
-    compiled = std::make_shared<const Scene>(compile_scene(desc));
+    return pending.get();  // or the compile's exception
   }
+  std::promise<std::shared_ptr<const Scene>> promise;
+  const uint64_t mine = ++cache.generation;
+  cache.seed = seed;
+  cache.scene = promise.get_future().share();
+  std::shared_ptr<const Scene> compiled;
+  try {
+    const SceneDesc desc = reload(scene, seed);
+    std::vector<InputFile> inputs;
+    {
+      py::gil_scoped_release release;
+      compiled = std::make_shared<const Scene>(compile_scene(desc, {}, &inputs));
+    }
+    remember_inputs(inputs);
+  } catch (...) {
+    promise.set_exception(std::current_exception());
+    if (cache.generation == mine) cache.scene = {};
+    throw;
+  }
+  promise.set_value(compiled);
   warn_of(*compiled);
-  cache = {seed, compiled};
   return compiled;
 }
 
@@ -212,9 +311,12 @@ Film film_of(const PyScene& scene) {
   return Film(compiled->settings.width, compiled->settings.height, compiled->film_exponent);
 }
 
-// Samples [s0, s1) of every pixel into the film; a stopped render leaves the film as it was.
+// Samples [s0, s1) of every pixel into the film; a stopped render leaves the film as it was. The
+// film is claimed throughout (render/film.h): another thread's render_into or save of it
+// meanwhile is a ValueError, where both would have returned and one's samples been lost.
 void render_into_film(const PyScene& scene, Film& film, int s0, int s1,
                       std::optional<uint64_t> seed, int threads, const py::object& progress) {
+  const FilmClaim claim(film);
   const auto compiled = compiled_scene(scene, seed);
   if (film.width != compiled->settings.width || film.height != compiled->settings.height)
     throw py::value_error("the film is " + std::to_string(film.width) + "x" +
@@ -347,15 +449,15 @@ py::tuple media_at(const PyScene& scene, const Rows& points) {
 }
 
 // Runs experiment `name` (docs/reproduction.md) into `out`; returns its files and summary.
-py::tuple run_experiment(const std::string& name, const std::filesystem::path& out,
-                         const std::filesystem::path& scenes, bool quick, uint64_t seed,
-                         int threads) {
+py::tuple run_experiment(const std::string& name, const py::object& out, const py::object& scenes,
+                         bool quick, uint64_t seed, int threads) {
   for (const Experiment& e : experiments()) {
     if (e.name != name) continue;
+    const ExperimentOptions options{path_of(out), path_of(scenes), quick, seed, threads};
     ExperimentReport report;
     {
       py::gil_scoped_release release;
-      report = e.run(ExperimentOptions{out, scenes, quick, seed, threads});
+      report = e.run(options);
     }
     std::vector<std::string> files;
     for (const auto& f : report.files) files.push_back(f.string());
@@ -409,18 +511,29 @@ PYBIND11_MODULE(_core, m) {
            })
       .def(
           "save",
-          [](const nimbus::Film& f, const std::filesystem::path& path) {
-            py::gil_scoped_release release;
-            nimbus::save_film(f, path.string());
+          [](nimbus::Film& f, const py::object& path_arg) {
+            const std::string path = np::path_of(path_arg);
+            np::check_output("Film.save", path, false);
+            // Written without the GIL: a render_into ending meanwhile must not replace it.
+            const nimbus::FilmClaim claim(f, "saved");
+            np::os_errors([&] {
+              py::gil_scoped_release release;
+              nimbus::save_film(f, path);
+            });
           },
-          py::arg("path"))
+          py::arg("path"),
+          "Saves the film atomically; the path follows write_image's rules (ValueError), and a "
+          "film being rendered into is not saved meanwhile (ValueError).")
       .def_static(
           "load",
-          [](const std::filesystem::path& path) {
-            py::gil_scoped_release release;
-            return nimbus::load_film(path.string());
+          [](const py::object& path_arg) {
+            const std::string path = np::path_of(path_arg);
+            return np::os_errors([&] {
+              py::gil_scoped_release release;
+              return nimbus::load_film(path);
+            });
           },
-          py::arg("path"))
+          py::arg("path"), "A film saved by Film.save; OSError if the file is not one.")
       .def("__repr__", [](const nimbus::Film& f) {
         return "<nimbus.Film " + std::to_string(f.width) + "x" + std::to_string(f.height) + ">";
       });
@@ -450,21 +563,25 @@ PYBIND11_MODULE(_core, m) {
   });
   m.def(
       "write_image",
-      [](const std::string& path, py::array_t<float, py::array::c_style> a) {
+      [](const py::object& path_arg, py::array_t<float, py::array::c_style> a) {
+        const std::string path = np::path_of(path_arg);
+        np::check_output("write_image", path, true);
         nimbus::Image image{int(a.shape(1)), int(a.shape(0)), {}};
         image.rgb.assign(a.data(), a.data() + a.size());
-        py::gil_scoped_release release;
-        nimbus::write_image(path, image);
+        np::os_errors([&] {
+          py::gil_scoped_release release;
+          nimbus::write_image(path, image);
+        });
       },
       py::arg("path"), py::arg("array"));
   m.def(
       "read_exr",
-      [](const std::string& path, const std::string& layer) {
-        nimbus::Image image;
-        {
+      [](const py::object& path_arg, const std::string& layer) {
+        const std::string path = np::path_of(path_arg);
+        const nimbus::Image image = np::os_errors([&] {
           py::gil_scoped_release release;
-          image = nimbus::read_exr(path);
-        }
+          return nimbus::read_exr(path);
+        });
         if (layer.empty()) return np::to_array(image);
         std::vector<std::string> names;
         for (const nimbus::ImageLayer& l : image.layers) {

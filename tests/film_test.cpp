@@ -8,9 +8,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <limits>
+#include <mutex>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "nimbus/frep/primitives.h"
 #include "nimbus/io/film_file.h"
@@ -177,6 +180,40 @@ TEST(Film, CancelledRendersLeaveWholePixelsOnly) {
     EXPECT_FALSE(rest.cancelled);
   }
   expect_same_bits(render(scene).film, film);
+}
+
+// Issue 44: two threads rendering into one film at once both returned, and one's samples were
+// lost. The second is refused while the first holds the film; the first completes.
+TEST(Film, TakesOneRenderAtATime) {
+  const Scene scene = small_scene(2);
+  Film film(37, 23);
+  std::promise<void> claimed, refused;
+  std::shared_future<void> second_refused = refused.get_future().share();
+  std::once_flag first_poll;
+  RenderOptions first = range(0, 0, -1, -1, 0, 2, 1);
+  first.cancel = [&] {  // polled once the film is claimed: waits for the second to be refused
+    std::call_once(first_poll, [&] { claimed.set_value(); });
+    second_refused.wait();
+    return false;
+  };
+  std::thread render_first([&] { render_into(scene, film, first); });
+  claimed.get_future().wait();
+  try {
+    render_into(scene, film, range(0, 0, -1, -1, 0, 1));
+    ADD_FAILURE() << "a second render into a film in use was let through";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(),
+                 "the film is already being rendered into (on another thread): wait for that to "
+                 "end, or use another film");
+  }
+  refused.set_value();
+  render_first.join();
+  expect_same_bits(render(scene).film, film);
+  // Free again; a copy of a film in use is free.
+  EXPECT_NO_THROW(render_into(scene, film, range(0, 0, -1, -1, 2, 3)));
+  const FilmClaim held(film);
+  Film copy = film;
+  EXPECT_NO_THROW(render_into(scene, copy, range(0, 0, -1, -1, 3, 4)));
 }
 
 // Issue 16: a NaN, an infinity or a value whose square overflows never enters the sums; it

@@ -258,6 +258,8 @@ TEST_F(Instances, BadInstancesAreOneLineNamingThePlace) {
             at + "/file: missing.npy: cannot open file (No such file or directory)");
   EXPECT_EQ(file("."), at + "/file: .: cannot open file (is a directory)");
   EXPECT_EQ(file(""), at + "/file: must name a file");
+  // Issue 44: the name was cut at the NUL, and shape.npy read.
+  EXPECT_EQ(file(R"(shape.npy\u0000junk)"), at + "/file: a file name cannot hold a NUL byte");
   EXPECT_EQ(error(with("[]")), at + ": must hold at least one transform");
   EXPECT_EQ(error(with("3")), at + R"(: expected an array of transforms or {"file": "NAME.npy"})");
   EXPECT_EQ(error(with(R"({"file": "shape.npy", "fiel": 1})")),

@@ -5,10 +5,13 @@
 
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
+#include <thread>
 
 #include "nimbus/job/checkpoint.h"
 #include "nimbus/job/film_patch.h"
 #include "nimbus/job/fingerprint.h"
+#include "nimbus/job/shared_render.h"
 #include "nimbus/job/work_queue.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
@@ -253,6 +256,33 @@ TEST(Fingerprint, HoldsEveryFileTheLoaderRead) {
   // Size and hash as read, beside the path.
   EXPECT_EQ(before["files"]["/media/m/emission/file"]["bytes"], fs::file_size(dir / "heat.vdb"));
   fs::remove_all(dir);
+}
+
+// Issue 44: an exception on the lead's render thread (there from WorkQueue::complete) left its
+// unit out for good, and the serving thread waited for it forever. Here the render's cancel poll
+// throws, on the render thread alone: the job must end, with that exception.
+TEST(SharedRender, AnExceptionOnTheRenderThreadEndsTheJob) {
+  const Scene scene = compile_scene(load_scene_text(R"({"film": {"width": 8, "height": 6},
+    "camera": {"type": "perspective", "from": [0, 0, 5], "to": [0, 0, 0], "fov": 30},
+    "integrator": {"spp": 4},
+    "objects": [{"shape": {"type": "sphere", "center": [0, 0, 0], "radius": 1}}]})",
+                                                    "<tiny>"));
+  SharedRenderSettings s;
+  s.spp = 4;
+  s.threads = 1;  // the render thread polls itself (no other pool thread)
+  s.start = make_film(scene);
+  const std::thread::id serving = std::this_thread::get_id();
+  s.stop = [serving] {
+    if (std::this_thread::get_id() != serving)
+      throw std::runtime_error("thrown on the render thread");
+    return false;
+  };
+  try {
+    lead_shared_render(scene, nullptr, std::move(s));
+    FAIL() << "the job ended without the exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "thrown on the render thread");
+  }
 }
 
 }  // namespace job_test

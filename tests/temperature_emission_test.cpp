@@ -277,6 +277,7 @@ TEST(TemperatureGridErrors, BadInputIsOneLineNamingTheJsonPathAndTheFile) {
            fmt::format("{:.3g}", std::max(planck_rgb(3e38f).max(), planck_spectrum(3e38f).scale)) +
            "; emitted light may be at most 1e+30"},
       {R"({"file": ""})", at + "/file: must name a file"},
+      {R"({"file": "hot.vdb\u0000junk"})", at + "/file: a file name cannot hold a NUL byte"},
       {R"({"file": "smoke.vdb", "grid": ""})", at + "/grid: must name a grid"},
       {R"({"grid": "flames"})", at + "/file: required key is missing"},
       {R"({"file": "nowhere.vdb", "sclae": 2})",

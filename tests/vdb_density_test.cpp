@@ -401,6 +401,8 @@ TEST(VdbDensity, BadInputIsOneLineNamingTheJsonPathAndTheFile) {
        scene + "/file: " + in_dir("wild.nvdb") +
            ": corrupted NanoVDB file (a node lies outside its grid)"},
       {R"({"type": "vdb", "file": ""})", scene + "/file: must name a file"},
+      {R"({"type": "vdb", "file": "nan.vdb\u0000junk"})",
+       scene + "/file: a file name cannot hold a NUL byte"},
       {R"({"type": "voxels"})",
        scene +
            R"(/type: unknown density type "voxels" (expected one of: constant, field, cloud, vdb))"},

@@ -115,7 +115,9 @@ def render_into(scene, film, samples, seed=None, threads=None, progress=False):
     """Adds the samples [s0, s1) of every pixel to `film` (nimbus.Film(scene)).
 
     Consecutive ranges, (0, 8) then (8, 16), give the bits of one render of 16 samples with
-    the same seed. A stopped render (Ctrl-C: KeyboardInterrupt) leaves the film as it was.
+    the same seed. A stopped render (Ctrl-C: KeyboardInterrupt) leaves the film as it was. A film
+    takes one render_into at a time: another thread's render_into or save of it meanwhile raises
+    ValueError ("the film is already being rendered into ...").
     """
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be a nimbus.Scene, not {type(scene).__name__}")
@@ -137,7 +139,12 @@ def render_into(scene, film, samples, seed=None, threads=None, progress=False):
 
 def write_image(path, array):
     """Writes a (height, width, 3) array of linear sRGB as EXR (float) or PNG (sRGB, 8 bits),
-    by the file's extension, atomically (a temporary file, then a rename), as nimbus render."""
+    by the file's extension, atomically (a temporary file, then a rename), as nimbus render.
+
+    The path follows `nimbus render -o`'s rules: ValueError, before writing, for an unknown
+    extension, a missing or unwritable folder, /dev, /proc or /sys, a directory, FIFO or device,
+    or a file that a scene loaded in this process reads (docs/python.md, "Paths and files").
+    OSError if the file cannot be written."""
     import numpy as np
     a = np.asarray(array)
     if a.dtype.kind not in "fiu":

@@ -83,13 +83,13 @@ bool same_file(const std::string& a, const std::string& b) {
 }
 
 void check_outputs_distinct(const std::vector<NamedFile>& outputs,
-                            const std::vector<NamedFile>& inputs) {
+                            const std::vector<NamedFile>& inputs, const std::string& reader) {
   for (size_t i = 0; i < outputs.size(); ++i) {
     const NamedFile& out = outputs[i];
     for (const NamedFile& in : inputs)
       if (same_file(out.path, in.path))
-        throw std::runtime_error(fmt::format("{} {}: is {} ({}), which the run reads", out.what,
-                                             out.path, in.what, in.path));
+        throw std::runtime_error(fmt::format("{} {}: is {} ({}), which {} reads", out.what,
+                                             out.path, in.what, in.path, reader));
     for (size_t j = 0; j < i; ++j)
       if (same_file(out.path, outputs[j].path))
         throw std::runtime_error(fmt::format("{} {}: is also the output of {} ({})", out.what,

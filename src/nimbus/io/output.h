@@ -34,8 +34,10 @@ struct NamedFile {
 bool same_file(const std::string& a, const std::string& b);
 
 // Throws std::runtime_error("WHAT PATH: problem") for the first output that is one of the inputs
-// or an earlier output, which writing it would destroy or overwrite.
+// or an earlier output, which writing it would destroy or overwrite. `reader` names who reads
+// the inputs: "-o out.json: is the scene file (out.json), which the run reads".
 void check_outputs_distinct(const std::vector<NamedFile>& outputs,
-                            const std::vector<NamedFile>& inputs);
+                            const std::vector<NamedFile>& inputs,
+                            const std::string& reader = "the run");
 
 }  // namespace nimbus

@@ -1,6 +1,7 @@
 #include "nimbus/job/shared_render.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstring>
 #include <stdexcept>
@@ -77,10 +78,11 @@ double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-// Rank 0's main thread until the job is over: answers the other ranks' reports, draws the
-// progress, saves checkpoints.
+// Rank 0's main thread until the job is over, or until the lead's render thread `failed` (its
+// unit may stay out for good: issue 44, a throw from WorkQueue::complete hung the render):
+// answers the other ranks' reports, draws the progress, saves checkpoints.
 void serve(WorkQueue& queue, JobChannel* channel, const SharedRenderSettings& s,
-           const std::function<bool()>& stop) {
+           const std::function<bool()>& stop, const std::atomic<bool>& failed) {
   const int ranks = channel ? channel->size() : 1;
   std::vector<int> waiting;  // ranks that asked for a unit and have not had an answer
   int gone = 0;              // ranks that were told the job is over, or left it
@@ -88,6 +90,7 @@ void serve(WorkQueue& queue, JobChannel* channel, const SharedRenderSettings& s,
   auto last_progress = Clock::time_point{};
   auto last_display = Clock::time_point{};
   for (;;) {
+    if (failed.load()) return;
     if (stop() && !queue.stopped()) queue.stop();
     while (std::optional<JobChannel::Message> m =
                channel ? channel->poll(kReportTag) : std::nullopt) {
@@ -151,7 +154,10 @@ SharedRenderResult lead_shared_render(const Scene& scene, JobChannel* channel,
   // renderer's tile), so the bands of a dense region are short.
   const int band_height = std::clamp(H / (4 * ranks), 1, 16);
   WorkQueue queue(std::move(s.start), s.spp, band_height, ranks, s.unit_seconds);
-  const auto stop = [&] { return s.stop && s.stop(); };
+  // An exception on either thread ends the job: the other stops at its next pixel or poll, and
+  // the exception leaves this function.
+  std::atomic<bool> failed{false};
+  const auto stop = [&] { return failed.load(std::memory_order_relaxed) || (s.stop && s.stop()); };
 
   std::exception_ptr local_failure;
   std::thread local([&] {
@@ -166,13 +172,15 @@ SharedRenderResult lead_shared_render(const Scene& scene, JobChannel* channel,
       }
     } catch (...) {
       local_failure = std::current_exception();
+      failed = true;
       queue.stop();
     }
   });
 
   try {
-    serve(queue, channel, s, stop);
+    serve(queue, channel, s, stop, failed);
   } catch (...) {
+    failed = true;
     queue.stop();
     local.join();
     throw;

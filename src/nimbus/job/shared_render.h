@@ -40,7 +40,8 @@ struct SharedRenderResult {
   bool stopped = false;                    // by `stop`, before every pixel reached spp
 };
 
-// The lead's part; `channel` null: this process alone.
+// The lead's part; `channel` null: this process alone. An exception on its render thread or its
+// serving thread (a callback's, WorkQueue's) stops the other and is rethrown here.
 SharedRenderResult lead_shared_render(const Scene& scene, JobChannel* channel,
                                       SharedRenderSettings settings);
 // Every other process's part: renders units until the lead says the job is over.

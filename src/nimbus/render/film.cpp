@@ -17,6 +17,19 @@ Rgb Film::variance_of_mean(int pixel) const {
   return var / n;
 }
 
+FilmClaim::FilmClaim(Film& film, const char* doing) : use_(film.use) {
+  const char* free = nullptr;
+  if (!use_.holder_.compare_exchange_strong(free, doing, std::memory_order_acquire))
+    throw std::invalid_argument(
+        fmt::format("the film is already being {} (on another thread): wait for that to end, or "
+                    "use another film",
+                    free));
+}
+
+FilmClaim::~FilmClaim() {
+  use_.holder_.store(nullptr, std::memory_order_release);
+}
+
 int film_exponent(double brightest) {
   if (!(brightest > 0) || !std::isfinite(brightest)) return 0;
   const int e = std::ilogb(brightest);

@@ -9,6 +9,7 @@
 // same bits when each pixel's samples are added in sample order (one render, or a render that
 // continues where the film left off), and agree to rounding otherwise.
 
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -19,6 +20,20 @@
 
 namespace nimbus {
 
+// Who is using a film that must not change or be read meanwhile (FilmClaim): render_into while it
+// adds samples. Of the object, not of its value: a copy starts unused, and an assignment leaves
+// the target's use as it was.
+class FilmUse {
+ public:
+  FilmUse() = default;
+  FilmUse(const FilmUse&) noexcept {}
+  FilmUse& operator=(const FilmUse&) noexcept { return *this; }
+
+ private:
+  friend class FilmClaim;
+  std::atomic<const char*> holder_{nullptr};  // what the user is doing: "rendered into"
+};
+
 struct Film {
   int width = 0, height = 0;
   // The exact sums count in units of 2^(exponent - 64) (film_exponent): the scale of the
@@ -28,6 +43,7 @@ struct Film {
   std::vector<Rgb> sum_sq;
   std::vector<uint32_t> samples;  // per pixel
   AovSums aov;                    // the AOVs' sums (render/aov.h), for those asked for
+  FilmUse use;                    // claimed by a render (FilmClaim); not part of the value
 
   Film() = default;
   Film(int w, int h, int exponent_ = 0, AovSet aovs = {}, int depth_exponent = 0)
@@ -61,6 +77,22 @@ struct Film {
   }
   // Variance of the pixel's mean estimate (sample variance / samples); 0 below 2 samples.
   Rgb variance_of_mean(int pixel) const;
+};
+
+// Holds a film for one user at a time, until it is destroyed: two renders into one film at
+// once (issue 44: two threads of a Python program) would race on the sums, and the samples of
+// one would be lost. `doing` says what the holder does, for the refusal of another:
+// std::invalid_argument("the film is already being rendered into (on another thread): wait for
+// that to end, or use another film").
+class FilmClaim {
+ public:
+  explicit FilmClaim(Film& film, const char* doing = "rendered into");
+  ~FilmClaim();
+  FilmClaim(const FilmClaim&) = delete;
+  FilmClaim& operator=(const FilmClaim&) = delete;
+
+ private:
+  FilmUse& use_;
 };
 
 // The film exponent for a scene whose brightest emitter has magnitude `brightest` (0 for none):

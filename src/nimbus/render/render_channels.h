@@ -68,10 +68,10 @@ RenderStats render_tiles(const Scene& scene, Film& film, const RenderRange& rang
             }
           }
         const long done = pixels_done += long(tile.rows().size()) * long(tile.cols().size());
-        if (options.progress && progress_mutex.try_lock()) {
+        // A lock that a throwing callback releases too: the exception ends the render.
+        if (const std::unique_lock lock(progress_mutex, std::try_to_lock);
+            options.progress && lock.owns_lock())
           options.progress(double(done) / range_pixels);
-          progress_mutex.unlock();
-        }
       });
 
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -60,6 +60,7 @@ RenderRange resolve(const Scene& scene, const Film& film, RenderRange r) {
 }  // namespace
 
 RenderStats render_into(const Scene& scene, Film& film, const RenderOptions& options) {
+  const FilmClaim claim(film);  // before the checks, which read the pixels another render adds to
   const RenderRange range = resolve(scene, film, options.range);
   const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);

@@ -39,7 +39,8 @@ struct RenderStats {
 // Adds the samples of options.range to `film`, which must have the scene's size; each pixel of
 // the range must hold either no samples (a film may start at any sample index, e.g. one of
 // several processes sharing a pixel's samples) or exactly range.s0 (it continues where it left
-// off); else std::invalid_argument, naming the pixel.
+// off); else std::invalid_argument, naming the pixel. The film is claimed meanwhile (FilmClaim in
+// render/film.h): a second render into it at the same time is std::invalid_argument.
 RenderStats render_into(const Scene& scene, Film& film, const RenderOptions& options = {});
 
 struct RenderResult {

@@ -1,7 +1,5 @@
 #include "nimbus/scene/density_types.h"
 
-#include <filesystem>
-
 #include "nimbus/media/cloud_density.h"
 #include "nimbus/media/constant_density.h"
 #include "nimbus/media/field_density.h"
@@ -40,9 +38,7 @@ DensityMaker read_vdb(JsonObject& d) {
   const auto grid = d.optional("grid");
   const auto transform = d.optional("transform");
   GridInput in;
-  const std::filesystem::path path = file.string();
-  if (path.empty()) file.fail("must name a file");
-  in.params.file = (std::filesystem::path(d.value().origin().folder) / path).string();
+  in.params.file = file.file();
   if (grid) in.params.grid = grid->string();
   if (in.params.grid.empty()) grid->fail("must name a grid");
   if (transform) in.params.transform = read_transform(*transform);

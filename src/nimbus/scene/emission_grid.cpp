@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <filesystem>
 
 #include "nimbus/scene/load.h"
 
@@ -39,10 +38,7 @@ EmissionGridMaker read_emission_grid(const JsonValue& v) {
   const auto transform = o.optional("transform");
   GridInput in;
   in.params.grid = "temperature";
-  const std::filesystem::path path = file.string();
-  if (path.empty()) file.fail("must name a file");
-  // Relative to the scene file's folder, as the "vdb" density's file.
-  in.params.file = (std::filesystem::path(v.origin().folder) / path).string();
+  in.params.file = file.file();  // relative to the scene file's folder, as the "vdb" density's
   if (grid) in.params.grid = grid->string();
   if (in.params.grid.empty()) grid->fail("must name a grid");
   const double s = scale ? scale->number(kEmission) : 1.0;

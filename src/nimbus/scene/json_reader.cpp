@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 
 namespace nimbus {
@@ -193,6 +194,13 @@ bool JsonValue::boolean() const {
 std::string JsonValue::string() const {
   if (!json_->is_string()) fail(fmt::format("expected a string, not {}", type_name(*json_)));
   return json_->get<std::string>();
+}
+
+std::string JsonValue::file() const {
+  const std::string name = string();
+  if (name.empty()) fail("must name a file");
+  if (name.find('\0') != std::string::npos) fail("a file name cannot hold a NUL byte");
+  return (std::filesystem::path(origin_->folder) / name).string();
 }
 
 Vec3 JsonValue::vec3(const Range& range) const {

@@ -74,6 +74,9 @@ class JsonValue {
   uint64_t unsigned_integer() const;
   bool boolean() const;
   std::string string() const;
+  // A file named here: a non-empty string without a NUL byte (at which the C library would cut
+  // the name: issue 44, "fire.vdb\u0000junk" read fire.vdb), joined to the origin's folder.
+  std::string file() const;
   // [x, y, z]; a component outside the range is reported at its own pointer (".../1").
   Vec3 vec3(const Range& range = {}) const;
   // A nonzero [x, y, z].

@@ -413,8 +413,7 @@ class Loader {
       JsonObject o(v);
       const JsonValue file = o.required("file");
       o.finish(R"(for instances from a file)");
-      if (file.string().empty()) file.fail("must name a file");
-      const std::string path = (std::filesystem::path(v.origin().folder) / file.string()).string();
+      const std::string path = file.file();
       try {
         transforms = read_instances_file(path);
       } catch (const InstancesFileError& e) {
