@@ -20,6 +20,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <optional>
 #include <string>
@@ -96,13 +97,30 @@ const char* signal_name(int sig) {
 // One line, redrawn: what is being done, a bar, the fraction, the time so far and the ETA.
 // Whether a progress bar's line is open (drawn after a \r, not yet ended): a warning ends it
 // first, and a render without a bar (-q, or stderr not a terminal) prints no empty lines.
-std::atomic<bool> g_bar_open{false};
+// Bars and warnings come from several threads (the render's, the display server's): one at a
+// time, so that a warning never lands inside a bar's line (issue 44).
+std::mutex g_stderr_mutex;
+bool g_bar_open = false;  // guarded by g_stderr_mutex
+
+void end_bar_line_locked() {
+  if (g_bar_open) std::fprintf(stderr, "\n");
+  g_bar_open = false;
+}
 
 void end_bar_line() {
-  if (g_bar_open.exchange(false)) std::fprintf(stderr, "\n");
+  std::lock_guard lock(g_stderr_mutex);
+  end_bar_line_locked();
+}
+
+// "nimbus: warning: W" on a line of its own.
+void print_warning(const std::string& w) {
+  std::lock_guard lock(g_stderr_mutex);
+  end_bar_line_locked();
+  std::fprintf(stderr, "nimbus: warning: %s\n", nimbus::printable_line(w).c_str());
 }
 
 void print_progress(const char* what, double fraction, double elapsed) {
+  std::lock_guard lock(g_stderr_mutex);
   g_bar_open = true;
   const int width = 40, filled = static_cast<int>(fraction * width);
   const double eta = fraction > 0 ? elapsed * (1 - fraction) / fraction : 0;
@@ -199,10 +217,7 @@ nimbus::RenderJobOptions job_options(const RenderArgs& args) {
   if (args.checkpoint_interval > 0) o.checkpoint_interval = args.checkpoint_interval;
   o.resume = args.resume;
   o.cancel = [] { return g_signal.load() != 0; };
-  o.warning = [](const std::string& w) {
-    end_bar_line();
-    std::fprintf(stderr, "nimbus: warning: %s\n", nimbus::printable_line(w).c_str());
-  };
+  o.warning = print_warning;
   return o;
 }
 
@@ -750,6 +765,39 @@ CLI::Validator unsigned_64() {
       "UINT64");
 }
 
+// export-vdb's voxel size, in the range that OpenVDB and a reader of the file accept
+// (io/vdb_export.h), checked before the scene is read.
+CLI::Validator voxel_size() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        // strtod, not stod: a number past a double's range (1e999, 1e-400) is out of range
+        // rather than "not a number".
+        char* end = nullptr;
+        const double x = std::strtod(value.c_str(), &end);
+        if (value.empty() || end != value.c_str() + value.size())
+          return fmt::format("must be a number, not \"{}\"", value);
+        if (nimbus::vdb_voxel_size_problem(x).empty()) return {};
+        return fmt::format("must be in [{:g}, {:g}], not {}", nimbus::kVdbExportMinVoxelSize,
+                           nimbus::kVdbExportMaxVoxelSize, value);
+      },
+      "H");
+}
+
+// --display-server's HOST:PORT (io/display_server.h), checked before the scene is read: an
+// empty address, a missing port or an IPv6 address outside brackets is a usage error.
+CLI::Validator display_address() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        try {
+          nimbus::parse_display_address(value);
+        } catch (const std::invalid_argument& e) {
+          return e.what();
+        }
+        return {};
+      },
+      "HOST:PORT");
+}
+
 // --aov's list, "albedo,normal": names of AOVs (render/setting_names.h), none twice.
 CLI::Validator aov_names() {
   return CLI::Validator(
@@ -825,8 +873,10 @@ int run_command(int argc, char** argv, const Cluster& cluster) {
                    "comma-separated list of albedo, normal, depth, variance (overrides film.aov; "
                    "docs/cli.md)")
       ->check(aov_names());
-  render->add_option("--display-server", args.display_server,
-                     "Stream the render to a tev viewer at HOST:PORT as it refines (docs/cli.md)");
+  render
+      ->add_option("--display-server", args.display_server,
+                   "Stream the render to a tev viewer at HOST:PORT as it refines (docs/cli.md)")
+      ->check(display_address());
   render->add_option("--resume", args.resume,
                      "Continue the render of this checkpoint up to --spp (default: the spp it "
                      "was started with); later checkpoints go to the same file unless "
@@ -883,8 +933,12 @@ int run_command(int argc, char** argv, const Cluster& cluster) {
       "export-vdb", "Write an object's medium as an OpenVDB fog volume (docs/cli.md)");
   export_vdb->add_option("scene", exp_vdb.scene, "Scene file (JSON)")->required();
   export_vdb->add_option("-o,--output", exp_vdb.output, "Output file (.vdb)")->required();
-  export_vdb->add_option("--voxel-size", exp_vdb.voxel_size, "Voxel size H in world units (> 0)")
-      ->required();
+  export_vdb
+      ->add_option("--voxel-size", exp_vdb.voxel_size,
+                   fmt::format("Voxel size H in world units, in [{:g}, {:g}]",
+                               nimbus::kVdbExportMinVoxelSize, nimbus::kVdbExportMaxVoxelSize))
+      ->required()
+      ->check(voxel_size());
   export_vdb
       ->add_option("--object", exp_vdb.object,
                    "Index into the scene's objects (default: the first with a medium)")

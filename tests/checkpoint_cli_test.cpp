@@ -9,6 +9,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -185,6 +186,62 @@ TEST_F(Checkpoints, ACheckpointOfOtherSettingsIsRefused) {
   EXPECT_FALSE(fs::exists(dir_ / "b.exr"));
   // Threads, outputs and spp change no pixel's samples: accepted.
   EXPECT_EQ(nimbus("--resume ck.nck --spp 3 --threads 1 -o c.png").code, 0);
+}
+
+// Issue 44: `--seed 0`, the default, was refused against a checkpoint whose scene left the seed
+// out ("absent in the checkpoint, 0 now"). Every setting `nimbus settings` lists, spelt out at its
+// default, is the render that leaves it out, both ways round; a setting at another value is not.
+TEST_F(Checkpoints, SettingsGivenAtTheirDefaultsAreTheSameRender) {
+  std::ofstream(dir_ / "plain.json") << R"({
+    "film": {"width": 12, "height": 8}, "integrator": {"spp": 2},
+    "camera": {"type": "perspective", "from": [0, 1, 6], "to": [0, 0, 0], "fov": 35},
+    "lights": [{"type": "environment", "radiance": 1}],
+    "objects": [{"shape": {"type": "sphere", "radius": 1}}]})";
+  const Ran settings = run_nimbus_in(dir_, "settings");
+  ASSERT_EQ(settings.code, 0) << settings.err;
+  std::string defaults;  // --set KEY=DEFAULT for every setting the scene leaves out
+  int count = 0;
+  std::istringstream lines(settings.out);
+  for (std::string key, value, rest; lines >> key >> value && std::getline(lines, rest);) {
+    if (key == "film.width" || key == "film.height" || key == "integrator.spp") continue;
+    defaults += " --set '" + key + "=" + value + "'";
+    ++count;
+  }
+  EXPECT_GE(count, 15) << settings.out;
+  const auto render = [&](const std::string& args) {
+    return run_nimbus_in(dir_, "render plain.json -q " + args);
+  };
+  ASSERT_EQ(render("--checkpoint plain.nck -o a.exr").code, 0);
+  const Ran spelt = render("--resume plain.nck --seed 0 --spp 3 -o b.exr" + defaults);
+  EXPECT_EQ(spelt.code, 0) << spelt.err;
+  ASSERT_EQ(render("--checkpoint spelt.nck --seed 0 -o c.exr" + defaults).code, 0);
+  const Ran plain = render("--resume spelt.nck --spp 3 -o d.exr");
+  EXPECT_EQ(plain.code, 0) << plain.err;
+  EXPECT_TRUE(same_bytes(dir_ / "b.exr", dir_ / "d.exr")) << "b.exr and d.exr differ";
+  const Ran other = render("--resume plain.nck --seed 1 -o e.exr");
+  EXPECT_EQ(other.err,
+            "nimbus: --resume plain.nck: the checkpoint is of another scene or other settings "
+            "(scene.integrator.seed: 0 in the checkpoint, 1 now)\n");
+}
+
+// Issue 44: a resumed run's samples_per_second divided the whole image's samples by the run's
+// own time. Its rates count what it rendered: the samples it added to the checkpoint's.
+TEST_F(Checkpoints, AResumedRunsStatsCountItsOwnSamples) {
+  ASSERT_EQ(nimbus("--spp 2 --checkpoint ck.nck -o a.exr").code, 0);
+  const Ran resumed = nimbus("--resume ck.nck --spp 3 --stats s.json -o b.exr");
+  ASSERT_EQ(resumed.code, 0) << resumed.err;
+  std::ifstream f(dir_ / "s.json");
+  const nlohmann::json s = nlohmann::json::parse(f);
+  const double pixels = 24 * 16;
+  EXPECT_EQ(s["checkpoint"]["samples_at_start"], 2 * pixels);
+  EXPECT_EQ(s["checkpoint"]["samples"], 3 * pixels);
+  EXPECT_EQ(s["samples"], pixels);
+  EXPECT_EQ(s["counters"]["paths"], pixels);
+  const double seconds = s["wall_seconds"];
+  ASSERT_GT(seconds, 0);
+  EXPECT_DOUBLE_EQ(s["samples_per_second"].get<double>(), pixels / seconds);
+  EXPECT_DOUBLE_EQ(s["counters"]["density_lookups_per_sample"].get<double>(),
+                   s["counters"]["density_lookups"].get<double>() / pixels);
 }
 
 // Issue 29: an output named like an input or like another output destroyed it (--stats s.json

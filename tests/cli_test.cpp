@@ -219,6 +219,7 @@ TEST_F(Cli, RendersDefaultOutputsAndStats) {
   EXPECT_EQ(s["settings"]["integrator"]["spp"], 3);
   EXPECT_EQ(s["threads"], 2);
   EXPECT_EQ(s["counters"]["paths"], 8 * 12 * 3);
+  EXPECT_EQ(s["samples"], 8 * 12 * 3);
   EXPECT_GT(s["samples_per_second"].get<double>(), 0);
   for (int c = 0; c < 3; ++c) {
     EXPECT_GT(s["image_mean"][c].get<double>(), 0);
@@ -348,8 +349,7 @@ TEST_F(Cli, SignalsStopTheOctreeBuildAndWriteNothing) {
   EXPECT_EQ(exit_code, 130);
   std::stringstream err;
   err << err_file.rdbuf();
-  EXPECT_EQ(err.str(),
-            "nimbus: stopped by SIGINT while compiling the scene; nothing written\n");
+  EXPECT_EQ(err.str(), "nimbus: stopped by SIGINT while compiling the scene; nothing written\n");
   fs::remove(dir_ / "code.txt");
   fs::remove(dir_ / "err.txt");
   EXPECT_TRUE(outputs().empty());

@@ -130,19 +130,51 @@ TEST_F(VdbCli, ExportVdbWritesAFileThatOpenVdbReadsAndThatRenders) {
 
 TEST_F(VdbCli, ExportVdbRefusesBadInputWithExitTwoAndNoOutput) {
   write("scene.json", scene_with());
+  // A medium far from the origin, and one whose bounds' only voxel centre (the origin, for
+  // H = 1.5) is in its hole.
+  const std::string fog =
+      R"("media": {"fog": {"sigma_a": 1, "sigma_s": 1, "density": {"type": "constant"}}})";
+  write("far.json", R"({"camera": {"from": [0, 0, 5], "to": [0, 0, 0]}, )" + fog +
+                        R"(, "objects": [{"shape": {"type": "sphere", "center": [10, 10, 10],
+                                                    "radius": 1}, "medium": "fog"}]})");
+  write("hollow.json", R"({"camera": {"from": [0, 0, 5], "to": [0, 0, 0]}, )" + fog +
+                           R"(, "objects": [{"shape": {"type": "difference", "shapes": [
+                                 {"type": "sphere", "radius": 1},
+                                 {"type": "sphere", "radius": 0.5}]}, "medium": "fog"}]})");
   write("bad.json", R"({"camera": {"from": [0, 0, 5], "to": [0, 0, 0]}, "film": {"width": 0}})");
   struct Case {
     const char* args;
     const char* message;
   };
   const Case cases[] = {
-      {"export-vdb scene.json -o out.vdb --voxel-size 0", "nimbus: --voxel-size must be > 0"},
-      {"export-vdb scene.json -o out.vdb --voxel-size 1e-5", "nimbus: --voxel-size 1e-05: "},
-      // Issue 29: these overflowed the voxel count and ended in OpenVDB's ArithmeticError, exit 1.
-      {"export-vdb scene.json -o out.vdb --voxel-size 1e-300",
-       "nimbus: --voxel-size 1e-300: the object's bounds hold inf voxels"},
+      // Outside the range OpenVDB and a reader accept, refused before the scene is read
+      // (issue 44: 1e300 wrote a file nimbus refused, 1e-5 leaked OpenVDB's ArithmeticError).
+      {"export-vdb scene.json -o out.vdb --voxel-size 0",
+       "nimbus: --voxel-size: must be in [1.5e-05, 1e+100], not 0"},
+      {"export-vdb scene.json -o out.vdb --voxel-size 1.4e-5",
+       "nimbus: --voxel-size: must be in [1.5e-05, 1e+100], not 1.4e-5"},
+      {"export-vdb scene.json -o out.vdb --voxel-size 1.1e100",
+       "nimbus: --voxel-size: must be in [1.5e-05, 1e+100], not 1.1e100"},
+      {"export-vdb scene.json -o out.vdb --voxel-size 1e300",
+       "nimbus: --voxel-size: must be in [1.5e-05, 1e+100], not 1e300"},
+      {"export-vdb scene.json -o out.vdb --voxel-size 1e999",
+       "nimbus: --voxel-size: must be in [1.5e-05, 1e+100], not 1e999"},
       {"export-vdb scene.json -o out.vdb --voxel-size 5e-324",
-       "nimbus: --voxel-size 5e-324: the object's bounds hold inf voxels"},
+       "nimbus: --voxel-size: must be in [1.5e-05, 1e+100], not 5e-324"},
+      {"export-vdb scene.json -o out.vdb --voxel-size -0.1",
+       "nimbus: --voxel-size: must be in [1.5e-05, 1e+100], not -0.1"},
+      {"export-vdb scene.json -o out.vdb --voxel-size nan",
+       "nimbus: --voxel-size: must be in [1.5e-05, 1e+100], not nan"},
+      {"export-vdb scene.json -o out.vdb --voxel-size 0.1x",
+       "nimbus: --voxel-size: must be a number, not \"0.1x\""},
+      // In the range, but too many voxels for the object's bounds, or none.
+      {"export-vdb scene.json -o out.vdb --voxel-size 1.5e-5",
+       "nimbus: --voxel-size 1.5e-05: the object's bounds hold "},
+      {"export-vdb far.json -o out.vdb --voxel-size 1e100",
+       "nimbus: --voxel-size 1e+100: no voxel centre (i H, j H, k H) lies in the object's bounds; "
+       "use a voxel size of at most 2"},
+      {"export-vdb hollow.json -o out.vdb --voxel-size 1.5",
+       "nimbus: --voxel-size 1.5: none of the 1 voxel centres in the object's bounds has medium"},
       {"export-vdb scene.json -o out.vdb --voxel-size 0.1 --object 7",
        "nimbus: --object 7: scene.json has 2 objects (0 to 1)"},
       {"export-vdb scene.json -o out.vdb --voxel-size 0.1 --object 0",
@@ -159,7 +191,7 @@ TEST_F(VdbCli, ExportVdbRefusesBadInputWithExitTwoAndNoOutput) {
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.args << ": " << r.err;
     EXPECT_EQ(r.err.rfind(c.message, 0), 0u)
         << c.args << ": expected \"" << c.message << "\" in: " << r.err;
-    EXPECT_TRUE(outputs({"scene.json", "bad.json"}).empty()) << c.args;
+    EXPECT_TRUE(outputs({"scene.json", "bad.json", "far.json", "hollow.json"}).empty()) << c.args;
   }
   EXPECT_EQ(run("export-vdb scene.json -o out.vdb").code, 2) << "--voxel-size is required";
 }

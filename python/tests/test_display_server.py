@@ -22,10 +22,10 @@ class StandIn(threading.Thread):
     """A tev stand-in: accepts connections one after another and rebuilds each one's image.
     drop_first: the first connection is closed after its first packet (a viewer going away)."""
 
-    def __init__(self, drop_first=False):
+    def __init__(self, drop_first=False, family=socket.AF_INET, host="127.0.0.1"):
         super().__init__(daemon=True)
-        self.server = socket.socket()
-        self.server.bind(("127.0.0.1", 0))
+        self.server = socket.socket(family)
+        self.server.bind((host, 0))
         self.server.listen(4)
         self.server.settimeout(0.1)
         self.port = self.server.getsockname()[1]
@@ -143,12 +143,32 @@ def test_a_viewer_that_goes_away_is_found_again(tmp_path):
 
 
 def test_a_bad_address_is_refused(tmp_path):
-    for address in ["localhost", "localhost:0", "localhost:99999", ":80", "host:port"]:
+    # Issue 44: the empty address was taken for none, "127.0.0.1:" gave an odd message.
+    for address in ["", "localhost", "localhost:0", "localhost:99999", ":80", "host:port",
+                    "127.0.0.1:", "::1:80", "[::1]"]:
         run = subprocess.run([EXE, "render", DEMO, "-o", str(tmp_path / "x.exr"),
                               "--display-server", address], capture_output=True, text=True)
         assert run.returncode == 2, address
-        assert run.stderr.startswith(f"nimbus: --display-server {address}:"), run.stderr
+        assert run.stderr.startswith(f'nimbus: --display-server: "{address}" ' if address else
+                                     "nimbus: --display-server: an empty address"), run.stderr
+        assert run.stderr.count("\n") == 1, run.stderr
         assert not (tmp_path / "x.exr").exists()
+
+
+def test_an_ipv6_viewer_in_brackets(tmp_path):
+    # Issue 44: "[::1]:PORT" said "cannot resolve the host".
+    try:
+        viewer = StandIn(family=socket.AF_INET6, host="::1")
+    except OSError:
+        return  # no IPv6 loopback here
+    viewer.start()
+    image, err = render(tmp_path, "a.exr", "--display-server", f"[::1]:{viewer.port}", spp=4,
+                        size=(16, 16))
+    time.sleep(0.3)
+    viewer.stop = True
+    viewer.join()
+    assert "warning" not in err
+    assert np.array_equal(viewer.images[-1], image)
 
 
 def test_a_viewer_that_stops_reading_does_not_stop_the_render(tmp_path):

@@ -279,6 +279,19 @@ def test_shape_values_are_a_numpy_evaluation_of_the_same_function():
     assert np.allclose(moved.values(points), sphere_f(points, [1.8, 2.3, 3], 0.5), atol=1e-12)
 
 
+def test_shape_values_stay_numbers_at_the_ends_of_the_documented_ranges():
+    # Issue 44: a perturbation of radius 1e100 with weights +1e15 and -1e15 gave NaN (its F of
+    # 1e200 cubed overflows: inf - inf). Each cube saturates at 1e280 (docs/scene-format.md).
+    huge = {"type": "sphere", "radius": 1e100}
+    shape = nimbus.Shape({"type": "freeform", "base": {"type": "sphere", "radius": 1},
+                          "perturbations": [{"shape": huge, "weight": 1e15},
+                                            {"shape": huge, "weight": -1e15}]})
+    points = np.array([[0, 0, 0], [0.5, 0, 0], [2, 0, 0], [1e50, 0, 0], [1e100, 0, 0],
+                       [-1e100, 1e100, 1e100]], float)
+    values = shape.values(points)
+    assert np.isfinite(values).all(), values
+
+
 def test_first_hit_is_where_dense_sampling_finds_the_first_crossing():
     rng = np.random.default_rng(7)
     origins = rng.normal(size=(300, 3))

@@ -36,7 +36,7 @@ Dual flat_free_form_at(const RayQuadratic& base, std::span<const Bump> bumps, do
   Dual f{base.at(t), base.derivative(t)};
   for (const Bump& bump : bumps) {
     const double q = bump.at(t);
-    if (q > 0) f = f + bump.weight * Dual{q * q * q, 3 * q * q * bump.slope(t)};
+    if (q > 0) f = f + bump.weight * positive_cube(Dual{q, bump.slope(t)});
   }
   return f;
 }

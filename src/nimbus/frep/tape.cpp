@@ -215,14 +215,14 @@ Tape compile_placed(const ShapeDesc& shape, const Mat4& placement, FUse use, con
 }
 
 double evaluate(const Tape& tape, const Vec3& p) {
-  return run_tape<double>(tape, [&](std::uint32_t i) { return tape.quadrics[i].eval(p); });
+  return run_tape<double>(tape, [&](std::uint32_t i) { return tape.quadrics[i].eval_finite(p); });
 }
 
 Vec3 gradient(const Tape& tape, const Vec3& p) {
   return run_tape<DualGrad>(tape,
                             [&](std::uint32_t i) {
                               const Quadric& q = tape.quadrics[i];
-                              return DualGrad{q.eval(p), q.gradient(p)};
+                              return DualGrad{q.eval_finite(p), q.gradient_finite(p)};
                             })
       .grad;
 }
@@ -233,7 +233,9 @@ Interval evaluate(const Tape& tape, const Box& box) {
     // value (0 says so), and anything else is enclosed by [-inf, 0] (see Compiler).
     if (intersect(tape.cull_box[i], box).empty())
       return tape.only_cubed[i] ? Interval::point(0) : Interval{-Box::kInf, 0.0};
-    return quadric_range(tape.quadrics[i], box);
+    // Terms of opposite signs past a double's range (issue 44): nothing is known.
+    const Interval range = quadric_range(tape.quadrics[i], box);
+    return range.lo == range.lo && range.hi == range.hi ? range : Interval{-Box::kInf, Box::kInf};
   });
 }
 

@@ -14,9 +14,10 @@
 
 namespace nimbus {
 
+// min(max(x, 0)³, kMaxPositiveCube) (math/interval.h).
 inline double positive_cube(double x) {
   const double p = x > 0 ? x : 0.0;
-  return p * p * p;
+  return std::min(p * p * p, kMaxPositiveCube);
 }
 inline bool nonpositive(double x) {
   return x <= 0;

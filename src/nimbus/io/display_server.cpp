@@ -1,16 +1,21 @@
 #include "nimbus/io/display_server.h"
 
 #include <fcntl.h>
+#include <fmt/format.h>
 #include <netdb.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <sys/types.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
 #include <stdexcept>
+#include <string_view>
+
+#include "nimbus/scene/json_reader.h"
 
 namespace nimbus {
 namespace {
@@ -57,18 +62,57 @@ void stage(Film& to, const Film& film) {
 
 }  // namespace
 
+DisplayAddress parse_display_address(const std::string& address) {
+  const auto problem = [&](const std::string& what) {
+    return std::invalid_argument(
+        fmt::format("\"{}\" {} (expected HOST:PORT, e.g. 127.0.0.1:{} or [::1]:{})",
+                    printable_line(address), what, kTevPort, kTevPort));
+  };
+  if (address.empty())
+    throw std::invalid_argument(
+        fmt::format("an empty address (expected HOST:PORT, e.g. 127.0.0.1:{})", kTevPort));
+  DisplayAddress a;
+  std::string rest;
+  if (address[0] == '[') {
+    const auto close = address.find(']');
+    if (close == std::string::npos) throw problem("has no ']' after the IPv6 address");
+    a.host = address.substr(1, close - 1);
+    if (a.host.find(':') == std::string::npos) throw problem("has no IPv6 address in brackets");
+    rest = address.substr(close + 1);
+    if (rest.empty() || rest[0] != ':') throw problem("has no ':' and port after the ']'");
+    rest.erase(0, 1);
+  } else {
+    const auto colon = address.rfind(':');
+    if (colon == std::string::npos) throw problem("has no ':' before a port");
+    a.host = address.substr(0, colon);
+    rest = address.substr(colon + 1);
+    if (a.host.find(':') != std::string::npos)
+      throw problem("has an IPv6 address outside brackets");
+    if (a.host.empty()) throw problem("has no host before the ':'");
+  }
+  // Names, IPv4 and IPv6 addresses (with a zone, fe80::1%eth0) use these characters only.
+  for (const char c : a.host)
+    if (!std::isalnum(static_cast<unsigned char>(c)) &&
+        std::string_view(".-_:%").find(c) == std::string_view::npos)
+      throw problem("has a host with a character no host name has");
+  if (rest.empty()) throw problem("has no port after the ':'");
+  if (rest.find_first_not_of("0123456789") != std::string::npos || rest.size() > 5 ||
+      std::stoi(rest) < 1 || std::stoi(rest) > 65535)
+    throw problem("has a port that is not a number in [1, 65535]");
+  a.port = rest;
+  return a;
+}
+
 DisplayServer::DisplayServer(const std::string& address, std::string name,
                              std::function<void(const std::string&)> warn)
     : address_(address), name_(std::move(name)), warn_(std::move(warn)) {
-  const auto colon = address.rfind(':');
-  if (colon == std::string::npos || colon == 0 || colon + 1 == address.size())
-    throw std::invalid_argument("--display-server " + address + ": expected HOST:PORT");
-  host_ = address.substr(0, colon);
-  port_ = address.substr(colon + 1);
-  if (port_.find_first_not_of("0123456789") != std::string::npos || port_.size() > 5 ||
-      std::stoi(port_) < 1 || std::stoi(port_) > 65535)
-    throw std::invalid_argument("--display-server " + address +
-                                ": the port must be a number in [1, 65535]");
+  try {
+    const DisplayAddress a = parse_display_address(address);
+    host_ = a.host;
+    port_ = a.port;
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("--display-server: ") + e.what());
+  }
   sender_ = std::thread([this] { send_loop(); });
 }
 
@@ -233,7 +277,10 @@ void DisplayServer::send_changes(const Film& film) {
       ++tiles_sent_;
     }
   }
-  warned_ = false;
+  // The viewer is back once a connection outlives its first update: sends to a new one succeed
+  // into the kernel's buffers even where the viewer then resets it, which warned again at each
+  // reconnection (issue 44).
+  if (!fresh) warned_ = false;
 }
 
 }  // namespace nimbus

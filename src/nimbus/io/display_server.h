@@ -22,10 +22,25 @@
 
 namespace nimbus {
 
+// tev's own port, for the messages' example.
+inline constexpr int kTevPort = 14158;
+
+// HOST:PORT split, the host without an IPv6 literal's brackets.
+struct DisplayAddress {
+  std::string host, port;
+};
+
+// Checks and splits `address`: HOST:PORT, HOST a name or an IPv4 address, or an IPv6 address in
+// brackets ([::1]:14158), PORT in [1, 65535]. Throws std::invalid_argument with the problem in
+// one line that quotes the address ("\"127.0.0.1:\" has no port after the ':' ..."), for
+// --display-server to prefix.
+DisplayAddress parse_display_address(const std::string& address);
+
 class DisplayServer {
  public:
-  // `address` is HOST:PORT (std::invalid_argument otherwise); `name` is the image's name in the
-  // viewer; `warn` gets the one-line warnings. Connects lazily, on the first update.
+  // `address` is HOST:PORT (parse_display_address; std::invalid_argument otherwise, its message
+  // starting "--display-server: "); `name` is the image's name in the viewer; `warn` gets the
+  // one-line warnings, from the sending thread. Connects lazily, on the first update.
   DisplayServer(const std::string& address, std::string name,
                 std::function<void(const std::string&)> warn);
   ~DisplayServer();
@@ -56,7 +71,7 @@ class DisplayServer {
   std::function<void(const std::string&)> warn_;
   // Owned by the sending thread (by finish once the thread is idle):
   int socket_ = -1;
-  bool warned_ = false;      // a warning was given since the last good connection
+  bool warned_ = false;      // a warning was given since a connection last outlived an update
   double next_attempt_ = 0;  // steady-clock seconds before which no reconnection is tried
   std::vector<std::uint32_t> sent_samples_;  // per pixel, at the last update sent
   std::vector<std::uint8_t> packet_;         // the packet being written, reused

@@ -74,6 +74,12 @@ int vdb_export_compiled(const Scene& scene, int object) {
       fmt::format("--object {}: the object holds nothing (its shape is empty)", object));
 }
 
+std::string vdb_voxel_size_problem(double h) {
+  if (h >= kVdbExportMinVoxelSize && h <= kVdbExportMaxVoxelSize) return {};
+  return fmt::format("must be in [{:g}, {:g}], not {:g}", kVdbExportMinVoxelSize,
+                     kVdbExportMaxVoxelSize, h);
+}
+
 double vdb_export_voxels(const Scene& scene, int object, double h) {
   const Box& b = scene.objects.at(object).bounds;
   // In doubles: the quotients may be far past any integer type.
@@ -87,8 +93,8 @@ double vdb_export_voxels(const Scene& scene, int object, double h) {
 
 VdbExportResult export_vdb(const Scene& scene, int object, double h, const std::string& path,
                            const BuildMonitor& monitor) {
-  if (!(h > 0) || !std::isfinite(h))
-    throw std::invalid_argument(fmt::format("--voxel-size must be > 0, not {}", h));
+  if (const std::string problem = vdb_voxel_size_problem(h); !problem.empty())
+    throw std::invalid_argument("--voxel-size: " + problem);
   const SceneObject& obj = scene.objects.at(object);
   if (obj.medium < 0) throw std::invalid_argument(fmt::format("object {} holds no medium", object));
   const Medium& medium = scene.media[obj.medium];
@@ -98,6 +104,14 @@ VdbExportResult export_vdb(const Scene& scene, int object, double h, const std::
         "--voxel-size {}: the object's bounds hold {:.3g} voxels, more than the {:.3g} an export "
         "may have; use a larger voxel size",
         h, voxels, kVdbExportMaxVoxels));
+  // A multiple of H lies in any interval at least H long.
+  if (voxels < 1) {
+    const Vec3 extent = obj.bounds.hi - obj.bounds.lo;
+    throw std::invalid_argument(fmt::format(
+        "--voxel-size {}: no voxel centre (i H, j H, k H) lies in the object's bounds; use a "
+        "voxel size of at most {:.3g}, the bounds' smallest extent",
+        h, std::min({extent.x, extent.y, extent.z})));
+  }
 
   // Blocks of 8³ voxels, aligned as OpenVDB's leaves, over the voxel centres in the bounds.
   AxisRange voxel[3], block[3];
@@ -182,6 +196,12 @@ VdbExportResult export_vdb(const Scene& scene, int object, double h, const std::
     if (!leaf->isEmpty()) grid->tree().addLeaf(leaf.release());
   }
   result.active_voxels = grid->activeVoxelCount();
+  // An empty grid would be a file that holds nothing: the voxels missed the medium.
+  if (result.active_voxels == 0)
+    throw std::invalid_argument(fmt::format(
+        "--voxel-size {}: none of the {:.0f} voxel centres in the object's bounds has medium; use "
+        "a smaller voxel size",
+        h, voxels));
 
   openvdb::initialize();
   grid->setName("density");

@@ -25,6 +25,16 @@ inline constexpr double kVdbExportThreshold = 1e-4;
 // The most voxels an export may cover (the object's bounds over H³): each costs a lookup unless
 // its block is culled, so more would run for an hour.
 inline constexpr double kVdbExportMaxVoxels = 4.0e9;
+// The voxel sizes an export accepts, whatever the scene. OpenVDB's linear transform refuses a
+// scale whose cube is below 3e-15 (H < 1.44e-5: "Non-zero scale values required"); a reader
+// needs the transform's determinant H³ finite (nimbus's vdb density refuses it otherwise), and
+// 1e100, the scene format's largest length, keeps it so (1e300).
+inline constexpr double kVdbExportMinVoxelSize = 1.5e-5;
+inline constexpr double kVdbExportMaxVoxelSize = 1e100;
+
+// What is wrong with a voxel size outside [kVdbExportMinVoxelSize, kVdbExportMaxVoxelSize]
+// ("must be in [1.5e-05, 1e+100], not 1e+300"), or "" for one inside.
+std::string vdb_voxel_size_problem(double voxel_size);
 
 struct VdbExportResult {
   std::uint64_t active_voxels = 0;
@@ -46,8 +56,9 @@ double vdb_export_voxels(const Scene& scene, int object, double voxel_size);
 
 // Builds the grid of `object` (which holds a medium) and writes it to `path` atomically
 // (io/atomic_file.h); the monitor sees the fraction of blocks done and may cancel. Throws
-// std::invalid_argument for a voxel size that is not > 0 or gives more than kVdbExportMaxVoxels
-// voxels, std::runtime_error("PATH: problem") when the file cannot be written.
+// std::invalid_argument, with nothing written, for a voxel size outside the range above, one
+// that gives more than kVdbExportMaxVoxels voxels or none in the object's bounds, or a grid
+// without an active voxel; std::runtime_error("PATH: problem") when the file cannot be written.
 VdbExportResult export_vdb(const Scene& scene, int object, double voxel_size,
                            const std::string& path, const BuildMonitor& monitor = {});
 

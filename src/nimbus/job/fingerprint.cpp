@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "nimbus/math/fnv.h"
+#include "nimbus/render/settings.h"
 
 namespace nimbus {
 namespace {
@@ -79,8 +80,14 @@ nlohmann::json render_fingerprint(const SceneDesc& desc, const std::vector<Input
   nlohmann::json fingerprint = nlohmann::json::object();
   fingerprint["nimbus"] = NIMBUS_VERSION;
   nlohmann::json& scene = fingerprint["scene"] = desc.document;  // the one copy
-  if (scene.is_object() && scene.contains("integrator") && scene["integrator"].is_object())
+  // The settings as the render uses them, every one spelt out, rather than as the document
+  // gives them: a setting given at its default is the default (issue 44: --seed 0 was refused
+  // against a checkpoint whose scene left the seed out).
+  if (scene.is_object()) {
+    const nlohmann::json settings = settings_json(desc.settings);
+    for (const auto& [section, values] : settings.items()) scene[section] = values;
     scene["integrator"].erase("spp");
+  }
   // Each file under the JSON pointer that named it, as compiling recorded it when it read it.
   nlohmann::json& files = fingerprint["files"] = nlohmann::json::object();
   for (const InputFile& f : inputs)

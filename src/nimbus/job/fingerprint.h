@@ -1,9 +1,10 @@
 #pragma once
 // What a checkpoint must match to be continued (job/checkpoint.h): everything that changes a
 // pixel's samples. The scene's document as loaded, after the --set overrides (--seed included),
-// without integrator.spp, which only says how many samples to take; the record of every file
-// compiling it read (compile_scene's `inputs`: VDB grids, wherever the document names them, with
-// their sizes and hashes taken as they were read); the nimbus version. Not the threads, the
+// its render settings (film, integrator, spectrum) each spelt out with its value, given or the
+// default, without integrator.spp, which only says how many samples to take; the record of every
+// file compiling it read (compile_scene's `inputs`: VDB grids, wherever the document names them,
+// with their sizes and hashes taken as they were read); the nimbus version. Not the threads, the
 // processes or the outputs, which change no pixel. Nothing is read or parsed again.
 
 #include <cstdint>

@@ -274,7 +274,9 @@ nlohmann::json RenderJob::stats(const JobOutcome& outcome) const {
   result.counters = outcome.counters;
   result.seconds = outcome.seconds;
   result.threads = outcome.threads;
-  nlohmann::json j = render_stats(scene_, result, scene_file_);
+  // This run's samples: a resumed film holds the checkpoint's too, which took none of its time.
+  nlohmann::json j = render_stats(scene_, result, scene_file_,
+                                  samples_held(outcome.film) - outcome.samples_at_start);
   if (!outcome.samples_per_rank.empty())
     j["mpi"] = {{"ranks", outcome.processes}, {"samples_per_rank", outcome.samples_per_rank}};
   if (!checkpoint_file_.empty())

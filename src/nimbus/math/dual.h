@@ -37,10 +37,13 @@ inline Dual max(Dual a, Dual b) {
 inline Dual min(Dual a, Dual b) {
   return a.value <= b.value ? a : b;
 }
-// d/dt max(f, 0)³ = 3 max(f, 0)² f'.
+// d/dt max(f, 0)³ = 3 max(f, 0)² f', saturated at kMaxPositiveCube (interval.h), where the
+// slope is 0.
 inline Dual positive_cube(Dual a) {
   const double p = a.value > 0 ? a.value : 0.0;
-  return {p * p * p, 3 * p * p * a.slope};
+  const double cube = p * p * p;
+  if (cube > kMaxPositiveCube) return {kMaxPositiveCube, 0.0};
+  return {cube, saturate_cube_term(3 * p * p * a.slope)};
 }
 
 // True when max(f, 0)³ and its derivative are exactly 0.
@@ -77,8 +80,17 @@ inline DualInterval min(DualInterval a, DualInterval b) {
   return {min(a.value, b.value), hull(a.slope, b.slope)};
 }
 inline DualInterval positive_cube(DualInterval a) {
-  const Interval p = max(a.value, Interval::point(0.0));
-  return {positive_cube(a.value), 3.0 * (square(p) * a.slope)};
+  // Where the cube saturates its slope is 0: p is cut to the cube root of the limit, and where
+  // only part of the interval saturates the slope's range takes in 0.
+  constexpr double kRoot = 2.2e93;  // above cbrt(kMaxPositiveCube) = 2.154e93
+  Interval p = max(a.value, Interval::point(0.0));
+  if (p.lo > kRoot) return {positive_cube(a.value), Interval::point(0.0)};
+  if (p.hi > kRoot) p = {0.0, kRoot};
+  const Interval slope = 3.0 * (square(p) * a.slope);
+  if (slope.lo != slope.lo || slope.hi != slope.hi)
+    return {positive_cube(a.value),
+            {-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()}};
+  return {positive_cube(a.value), slope};
 }
 
 inline DualGrad operator+(const DualGrad& a, const DualGrad& b) {
@@ -98,7 +110,10 @@ inline DualGrad min(const DualGrad& a, const DualGrad& b) {
 }
 inline DualGrad positive_cube(const DualGrad& a) {
   const double p = a.value > 0 ? a.value : 0.0;
-  return {p * p * p, (3 * p * p) * a.grad};
+  const double cube = p * p * p;
+  if (cube > kMaxPositiveCube) return {kMaxPositiveCube, Vec3{}};
+  const Vec3 g = (3 * p * p) * a.grad;
+  return {cube, {saturate_cube_term(g.x), saturate_cube_term(g.y), saturate_cube_term(g.z)}};
 }
 
 }  // namespace nimbus

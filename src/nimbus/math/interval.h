@@ -70,9 +70,25 @@ inline Interval cube(Interval a) {
   return {cube_down(a.lo), cube_up(a.hi)};
 }
 
-// max(x, 0)³, the perturbation R of eq. 2. An exact 0 stays exactly 0.
+// The most a perturbation's max(F, 0)³ counts (eq. 2), in every evaluation of it (point,
+// interval, dual, gradient): past it the cube saturates. A perturbation of radius 1e100 has F up
+// to 1e200, whose cube overflows, and two such terms of weights ±1e15 made F NaN (issue 44).
+// Saturated, a term is at most 1e15 · 1e280 and the sum of 20 000 of them (kMaxTapeQuadrics)
+// stays finite; no scene short of F ≈ 4.6e93 is changed.
+inline constexpr double kMaxPositiveCube = 1e280;
+
+// x clamped to ±kMaxPositiveCube, and NaN (0 · ∞ in a derivative) to 0.
+inline double saturate_cube_term(double x) {
+  return x >= kMaxPositiveCube    ? kMaxPositiveCube
+         : x <= -kMaxPositiveCube ? -kMaxPositiveCube
+         : x == x                 ? x
+                                  : 0.0;
+}
+
+// min(max(x, 0)³, kMaxPositiveCube), the perturbation R of eq. 2. An exact 0 stays exactly 0.
 inline Interval positive_cube(Interval a) {
-  return {a.lo > 0 ? cube_down(a.lo) : 0.0, a.hi > 0 ? cube_up(a.hi) : 0.0};
+  return {a.lo > 0 ? std::min(cube_down(a.lo), kMaxPositiveCube) : 0.0,
+          a.hi > 0 ? std::min(cube_up(a.hi), kMaxPositiveCube) : 0.0};
 }
 
 // True when max(x, 0)³ is exactly 0 over the whole interval.

@@ -7,9 +7,9 @@
 namespace nimbus {
 
 nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
-                            const std::string& scene_path) {
+                            const std::string& scene_path, std::uint64_t samples_rendered) {
   const Counters& c = result.counters;
-  const double samples = double(scene.settings.width) * scene.settings.height * scene.settings.spp;
+  const double samples = double(samples_rendered);
   const MeanEstimate m = image_mean(result.film);
   nlohmann::json j;
   j["scene"] = scene_path;
@@ -20,6 +20,7 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
                       ? scene.settings.spectral.wavelengths
                       : 3;
   j["wall_seconds"] = result.seconds;
+  j["samples"] = samples_rendered;
   j["samples_per_second"] = result.seconds > 0 ? samples / result.seconds : 0.0;
   j["image_mean"] = {m.mean[0], m.mean[1], m.mean[2]};
   j["image_mean_standard_error"] = {m.standard_error[0], m.standard_error[1], m.standard_error[2]};

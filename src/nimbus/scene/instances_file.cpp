@@ -2,13 +2,15 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
 #include <optional>
-#include <regex>
+
+#include "nimbus/scene/npy_header.h"
 
 #include "nimbus/os/regular_file.h"
 
@@ -16,43 +18,6 @@ namespace nimbus {
 namespace {
 
 constexpr char kMagic[] = "\x93NUMPY";
-constexpr std::size_t kMaxHeaderBytes = 1 << 16;
-
-struct Header {
-  int item_bytes = 8;  // 8: float64, 4: float32
-  std::vector<std::size_t> shape;
-};
-
-// The header is a Python dict literal, e.g.
-// {'descr': '<f8', 'fortran_order': False, 'shape': (1000, 3, 4), }
-Header parse_header(const std::string& text) {
-  const auto field = [&](const char* key, const char* value_pattern) -> std::string {
-    const std::regex re(std::string("'") + key + "'\\s*:\\s*(" + value_pattern + ")");
-    std::smatch m;
-    if (!std::regex_search(text, m, re))
-      throw InstancesFileError(fmt::format("the .npy header has no '{}'", key));
-    return m[1].str();
-  };
-  Header h;
-  const std::string descr = field("descr", "'[^']*'");
-  if (descr == "'<f8'")
-    h.item_bytes = 8;
-  else if (descr == "'<f4'")
-    h.item_bytes = 4;
-  else
-    throw InstancesFileError(fmt::format(
-        "holds {} values; expected little-endian float64 ('<f8') or float32 ('<f4')", descr));
-  if (field("fortran_order", "True|False") != "False")
-    throw InstancesFileError("is in Fortran order; save a C-ordered array");
-  const std::string shape = field("shape", "\\([^)]*\\)");
-  const std::regex number("[0-9]+");
-  for (auto it = std::sregex_iterator(shape.begin(), shape.end(), number);
-       it != std::sregex_iterator(); ++it) {
-    if (it->str().size() > 12) throw InstancesFileError("has a dimension too large to read");
-    h.shape.push_back(std::stoull(it->str()));
-  }
-  return h;
-}
 
 std::string shape_text(const std::vector<std::size_t>& shape) {
   std::string s = "(";
@@ -77,6 +42,7 @@ std::vector<Mat4> read_instances_file(const std::string& path) {
   if (!in.read(lead.data(), lead.size()) || std::memcmp(lead.data(), kMagic, 6) != 0)
     throw InstancesFileError("not a .npy file (write it with numpy.save)");
   const int major = static_cast<unsigned char>(lead[6]);
+  const int minor = static_cast<unsigned char>(lead[7]);
   std::size_t header_bytes = 0;
   if (major == 1) {
     std::array<unsigned char, 2> n{};
@@ -87,15 +53,29 @@ std::vector<Mat4> read_instances_file(const std::string& path) {
     in.read(reinterpret_cast<char*>(n.data()), 4);
     header_bytes =
         n[0] | std::size_t(n[1]) << 8 | std::size_t(n[2]) << 16 | std::size_t(n[3]) << 24;
-  } else {
-    throw InstancesFileError(
-        fmt::format(".npy format version {} is not supported (1 to 3 are)", major));
   }
-  if (!in || header_bytes > kMaxHeaderBytes) throw InstancesFileError("a broken .npy header");
+  // numpy reads versions 1.0, 2.0 and 3.0 only.
+  if (major < 1 || major > 3 || minor != 0)
+    throw InstancesFileError(fmt::format(
+        ".npy format version {}.{} is not supported (1.0, 2.0 and 3.0 are)", major, minor));
+  if (!in) throw InstancesFileError("a broken .npy header: the file ends in its length");
+  const std::size_t preamble = major == 1 ? 10 : 12;
+  // Checked before anything is allocated: a length past the file or numpy's limit.
+  if (header_bytes > file_bytes - std::min<std::uintmax_t>(file_bytes, preamble))
+    throw InstancesFileError(fmt::format(
+        "a broken .npy header: its length, {} bytes, is past the end of the file", header_bytes));
+  if (header_bytes > kMaxNpyHeaderBytes)
+    throw InstancesFileError(fmt::format("a .npy header of {} bytes; numpy reads at most {}",
+                                         header_bytes, kMaxNpyHeaderBytes));
   std::string text(header_bytes, '\0');
   if (!in.read(text.data(), std::streamsize(header_bytes)))
-    throw InstancesFileError("a broken .npy header");
-  const Header h = parse_header(text);
+    throw InstancesFileError("a broken .npy header: the file ends in it");
+  NpyHeader h;
+  try {
+    h = parse_npy_header(text);
+  } catch (const NpyHeaderError& e) {
+    throw InstancesFileError(e.what());
+  }
 
   const auto& s = h.shape;
   const bool translations = s.size() == 2 && s[1] == 3;
