@@ -971,12 +971,14 @@ int run_command(int argc, char** argv, const Cluster& cluster) {
   } catch (const std::bad_alloc&) {
     // Past the estimate (render/memory_estimate.h), e.g. a --max-memory above what the machine
     // has (issue 29: "nimbus: std::bad_alloc").
+    end_bar_line();
     std::fprintf(stderr,
                  "nimbus: out of memory: the machine could not give what the run needed "
                  "(does --max-memory allow more than it has?)\n");
     if (cluster.size > 1) cluster_abort(kExitFailure);
     return kExitFailure;
   } catch (const std::exception& e) {
+    end_bar_line();  // an error from the render thread may come while its bar is drawn
     std::fprintf(stderr, "nimbus: %s\n", nimbus::printable_line(e.what()).c_str());
     // The other ranks may be waiting for this one: end them all.
     if (cluster.size > 1) cluster_abort(kExitFailure);
