@@ -134,7 +134,13 @@ void DisplayServer::send_loop() {
     pending_ = false;
     sending_ = true;
     lock.unlock();
-    send_changes(staged_);
+    // An exception must not leave this thread (std::terminate): the viewer is given up instead,
+    // as for a lost connection, and the render goes on.
+    try {
+      send_changes(staged_);
+    } catch (const std::exception& e) {
+      drop(e.what());
+    }
     lock.lock();
     sending_ = false;
     idle_.notify_all();
