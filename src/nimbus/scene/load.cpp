@@ -811,8 +811,6 @@ SceneDesc load_scene_json(nlohmann::json j, const std::string& source,
   return load_json_in(std::move(j), source, "", overrides);
 }
 
-namespace {
-
 // The text must be UTF-8 (strictly: an overlong form or a surrogate is not) without NUL bytes,
 // which the JSON parser would take for the end of the input (issue 29).
 nlohmann::json parse_scene_text(const std::string& text, const std::string& source) {
@@ -844,8 +842,6 @@ nlohmann::json parse_scene_text(const std::string& text, const std::string& sour
   }
   return j;
 }
-
-}  // namespace
 
 SceneDesc load_scene_text(const std::string& text, const std::string& source,
                           const std::vector<std::string>& overrides) {
