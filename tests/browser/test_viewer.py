@@ -308,3 +308,31 @@ def test_bad_command_lines(tmp_path):
         assert code == 2 and err.count("\n") == 1 and "cannot listen" in err
     code, err = run(path, "--port", "70000")
     assert code == 2 and err.count("\n") == 1
+    # Beyond the loopback only when asked, and then said (issue 44).
+    code, err = run(path, "--host", "0.0.0.0", "--port", "0")
+    assert code == 2 and err.count("\n") == 1 and "not a loopback address" in err
+    assert "--allow-remote" in err
+
+
+def test_any_loopback_address_checks_the_host_header(scene):
+    p = subprocess.Popen([EXE, "view", scene, "--port", "0", "--threads", "1",
+                          "--host", "127.0.0.2"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        port = int(re.match(r"nimbus view: http://127\.0\.0\.2:(\d+)/", p.stdout.readline())[1])
+
+        def status(host_headers):
+            with socket.create_connection(("127.0.0.2", port), timeout=10) as s:
+                s.sendall(b"GET /state HTTP/1.1\r\n" +
+                          b"".join(b"Host: " + h.encode() + b"\r\n" for h in host_headers) +
+                          b"Connection: close\r\n\r\n")
+                return int(s.recv(12)[9:12])
+
+        assert status([f"127.0.0.2:{port}"]) == 200  # the page's own address
+        assert status(["localhost"]) == 200
+        assert status([f"rebound.example:{port}"]) == 403  # a DNS-rebinding page's
+        assert status([f"127.0.0.2:{port}", f"127.0.0.2:{port}"]) == 400
+    finally:
+        p.send_signal(2)
+        _, err = p.communicate(timeout=20)
+    assert p.returncode == 0 and err == "", err
