@@ -479,6 +479,52 @@ struct ViewArgs {
   std::optional<uint64_t> seed;
   int threads = 0;
   std::optional<std::string> max_memory;
+  bool allow_remote = false;
+};
+
+// Ends `nimbus view` once a signal has come: stops the server at once, and ends the process
+// after a grace time even if the render thread does not finish (a scene load stuck in a file
+// that never answers, say), as the signal asked. Destroyed, it waits for nothing more.
+class ViewSignalWatcher {
+ public:
+  ViewSignalWatcher() : thread_([this] { watch(); }) {}
+  ~ViewSignalWatcher() {
+    {
+      std::lock_guard lock(mutex_);
+      finished_ = true;
+    }
+    thread_.join();
+  }
+  void serving(nimbus::ViewServer* server) {
+    std::lock_guard lock(mutex_);
+    server_ = server;
+    if (server_ && g_signal.load() != 0) server_->stop();
+  }
+
+ private:
+  void watch() {
+    for (;;) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      std::lock_guard lock(mutex_);
+      if (finished_) return;
+      if (g_signal.load() != 0) break;
+    }
+    serving(server_);
+    constexpr auto kGrace = std::chrono::seconds(2);
+    const auto end = std::chrono::steady_clock::now() + kGrace;
+    while (std::chrono::steady_clock::now() < end) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      std::lock_guard lock(mutex_);
+      if (finished_) return;
+    }
+    std::fflush(stdout);
+    std::_Exit(0);
+  }
+
+  std::mutex mutex_;
+  nimbus::ViewServer* server_ = nullptr;
+  bool finished_ = false;
+  std::thread thread_;
 };
 
 // `nimbus view`: the scene rendered progressively in a web page (view/view_server.h) until a
@@ -503,6 +549,9 @@ int run_view(const ViewArgs& args) {
   server_options.host = args.host;
   server_options.port = args.port;
   server_options.name = std::filesystem::path(args.scene).stem().string();
+  server_options.allow_remote = args.allow_remote;
+  // Declared first, destroyed last: it watches the session's load and its end too.
+  ViewSignalWatcher watcher;
   std::unique_ptr<ViewSession> session;
   try {
     session = std::make_unique<ViewSession>(options);
@@ -520,16 +569,18 @@ int run_view(const ViewArgs& args) {
     return kExitBadInput;
   }
   const bool v6 = args.host.find(':') != std::string::npos;
-  std::printf("nimbus view: http://%s%s%s:%d/ (Ctrl-C stops)\n", v6 ? "[" : "", args.host.c_str(),
-              v6 ? "]" : "", port);
+  const std::string address =
+      fmt::format("{}{}{}:{}", v6 ? "[" : "", args.host, v6 ? "]" : "", port);
+  if (!server.loopback())
+    std::fprintf(stderr,
+                 "nimbus: warning: serving beyond this machine (--allow-remote): anyone who "
+                 "reaches %s sees the scene and can move the camera\n",
+                 address.c_str());
+  std::printf("nimbus view: http://%s/ (Ctrl-C stops)\n", address.c_str());
   std::fflush(stdout);
-  std::thread watcher([&server] {
-    while (g_signal.load() == 0) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    server.stop();
-  });
+  watcher.serving(&server);
   server.serve();
-  g_signal.store(g_signal.load() != 0 ? g_signal.load() : SIGTERM);  // ends the watcher
-  watcher.join();
+  watcher.serving(nullptr);
   return 0;
 }
 
@@ -890,7 +941,11 @@ int run_command(int argc, char** argv, const Cluster& cluster) {
   view->add_option("--port", view_args.port, "Port to serve on (0: any free port; default 8080)")
       ->check(integer_in(0, 65535));
   view->add_option("--host", view_args.host,
-                   "Address to serve on (default 127.0.0.1: this machine only)");
+                   "Address to serve on (default 127.0.0.1: this machine only; any other "
+                   "than a loopback address needs --allow-remote)");
+  view->add_flag("--allow-remote", view_args.allow_remote,
+                 "Allow a --host beyond the loopback: anyone who reaches it sees the scene and "
+                 "can move the camera");
   view->add_option("--spp", view_args.spp, "Samples per pixel to refine to (default: the scene's)")
       ->check(integer_in(1));
   view->add_option("--seed", view_args.seed, "Random seed (overrides integrator.seed)")

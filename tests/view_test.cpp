@@ -2,8 +2,11 @@
 // session's film against render()'s bits after a camera move, reloads and a broken file keeping
 // the last image, the noise figure, PNG bytes in memory, and the camera's messages.
 
+#include <arpa/inet.h>
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <filesystem>
@@ -16,6 +19,9 @@
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/json_reader.h"
 #include "nimbus/scene/load.h"
+#include "nimbus/view/camera_body.h"
+#include "nimbus/view/connection_table.h"
+#include "nimbus/view/loopback.h"
 #include "nimbus/view/preview.h"
 #include "nimbus/view/view_session.h"
 #include "support/process.h"
@@ -148,6 +154,31 @@ TEST_F(Session, ReloadsASavedFileAndKeepsTheLastImageOfABrokenOne) {
   EXPECT_EQ(session.frame().error, "");
 }
 
+// Issue 44: each replacement stamps differently from the one before, even from a failed load,
+// so the page shows the new reason rather than the last one.
+TEST_F(Session, AFileReplacedByAFifoADirectoryOrADeviceShowsWhy) {
+  ViewSession session(options());
+  ASSERT_TRUE(session.wait(done, 60));
+  const auto error_is = [&](const std::string& expected) {
+    return session.wait([&](const ViewFrame& g) { return g.error == expected; }, 60)
+               ? ::testing::AssertionSuccess()
+               : ::testing::AssertionFailure() << "the page shows " << session.frame().error;
+  };
+  fs::remove(scene_);
+  ASSERT_EQ(::mkfifo(scene_.c_str(), 0600), 0);
+  EXPECT_TRUE(error_is(scene_ + ": not a regular file (a FIFO)"));
+  fs::remove(scene_);
+  fs::create_directory(scene_);
+  EXPECT_TRUE(error_is(scene_ + ": cannot open file (is a directory)"));
+  fs::remove(scene_);
+  fs::create_symlink("/dev/zero", scene_);
+  EXPECT_TRUE(error_is(scene_ + ": not a regular file (a character device)"));
+  fs::remove(scene_);
+  write(scene_text("[0.5, 0.5, 0.5]"));
+  ASSERT_TRUE(session.wait([](const ViewFrame& g) { return g.loads == 2 && done(g); }, 60));
+  EXPECT_EQ(session.frame().error, "");
+}
+
 TEST_F(Session, ABrokenFileAtTheStartIsTheLoadersError) {
   write("{\"camera\": ");
   try {
@@ -243,6 +274,115 @@ TEST(LoadCameraJson, ChecksAsTheSceneFileDoes) {
   EXPECT_EQ(message(R"({"from": [0, 0, 1], "to": [0, 0, 0], "fov": 180})"),
             "camera: /camera/fov: must be in (0, 180)");
   EXPECT_EQ(message(R"([1, 2])"), "camera: /camera: expected an object, not an array");
+}
+
+std::string camera_body_error(std::string_view body) {
+  try {
+    parse_camera_body(body);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+// Issue 44: the camera a page posts is read as a scene file is, with its messages.
+TEST(ParseCameraBody, ReadsTheBodyAsASceneFileIsRead) {
+  EXPECT_EQ(parse_camera_body(R"({"from": [1, 2, 3], "to": [0, 0, 0]})").from, (Vec3{1, 2, 3}));
+  EXPECT_EQ(camera_body_error(R"({"from": [0, 0, 1e999], "to": [0, 0, 0]})"),
+            "camera: /from/2: the number 1e999 is beyond a double's range (finite, at most "
+            "1.8e308 in magnitude)");
+  EXPECT_EQ(camera_body_error(R"({"from": [0, 0, 1], "from": [0, 0, 2], "to": [0, 0, 0]})"),
+            R"(camera: /from: duplicate key "from")");
+  const std::string deep = camera_body_error(std::string(5000, '[') + std::string(5000, ']'));
+  EXPECT_TRUE(deep.starts_with("camera: /0/0/0")) << deep;
+  EXPECT_TRUE(deep.ends_with(fmt::format("nest deeper than {} levels", kMaxJsonDepth))) << deep;
+  EXPECT_EQ(camera_body_error("{\"from\": \"\xff\"}"), "camera: not UTF-8 text (byte 10)");
+  EXPECT_EQ(camera_body_error(R"({"from": [0, 0, 1], "to": [0, 0, 1]})"),
+            R"(camera: /camera/to: must differ from "from")");
+  EXPECT_TRUE(camera_body_error("{not json").starts_with("camera: parse error at line 1"));
+}
+
+using Clock = ConnectionTable::Clock;
+
+TEST(ConnectionTable, ANewcomerPastTheLimitDropsTheStalestWaitingConnection) {
+  ConnectionTable::Limits limits;
+  limits.total = 3;
+  limits.per_client = 2;
+  ConnectionTable table(limits);
+  const Clock::time_point t0{};
+  const auto s = std::chrono::seconds(1);
+  EXPECT_TRUE(table.add(10, "a", t0).empty());
+  EXPECT_TRUE(table.add(11, "a", t0 + s).empty());
+  table.answering(10, t0 + 2 * s);  // 10 is being answered: 11 is the stalest waiting one
+  EXPECT_EQ(table.add(12, "a", t0 + 2 * s), std::vector<int>{11});
+  EXPECT_TRUE(table.add(20, "b", t0 + 2 * s).empty());
+  // Three open (10, 12, 20): a fourth from another address drops the stalest of all.
+  EXPECT_EQ(table.add(30, "c", t0 + 3 * s), std::vector<int>{12});
+  EXPECT_EQ(table.open(), 3u);
+  // Every other one of "a" being answered: the newcomer is the one dropped.
+  table.answering(30, t0 + 3 * s);
+  table.answering(20, t0 + 3 * s);
+  EXPECT_EQ(table.add(13, "a", t0 + 3 * s), std::vector<int>{13});
+  table.remove(11);
+  table.remove(12);
+  table.remove(13);
+  EXPECT_EQ(table.open(), 3u);
+}
+
+TEST(ConnectionTable, AWholeRequestHasADeadlineAndSoHasItsAnswer) {
+  ConnectionTable::Limits limits;
+  limits.request = std::chrono::seconds(5);
+  limits.answer = std::chrono::seconds(3);
+  ConnectionTable table(limits);
+  const Clock::time_point t0{};
+  const auto s = std::chrono::seconds(1);
+  table.add(1, "a", t0);
+  table.add(2, "a", t0 + s);
+  EXPECT_EQ(table.next_deadline(), t0 + 5 * s);
+  EXPECT_TRUE(table.expired(t0 + 4 * s).empty());
+  table.answering(2, t0 + 4 * s);  // its request came: 3 s to take the answer
+  EXPECT_EQ(table.expired(t0 + 5 * s), std::vector<int>{1});
+  EXPECT_TRUE(table.expired(t0 + 6 * s).empty());  // each one once
+  EXPECT_EQ(table.expired(t0 + 7 * s), std::vector<int>{2});
+  table.add(3, "a", t0 + 7 * s);
+  table.answering(3, t0 + 8 * s);
+  table.answered(3, t0 + 9 * s);  // the next request has 5 s from the last answer
+  EXPECT_TRUE(table.expired(t0 + 13 * s).empty());
+  EXPECT_EQ(table.expired(t0 + 14 * s), std::vector<int>{3});
+  EXPECT_EQ(table.next_deadline(), Clock::time_point::max());
+}
+
+TEST(Loopback, AddressesAndHostHeaders) {
+  const auto v4 = [](const char* text) {
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    inet_pton(AF_INET, text, &a.sin_addr);
+    return is_loopback(reinterpret_cast<const sockaddr*>(&a));
+  };
+  const auto v6 = [](const char* text) {
+    sockaddr_in6 a{};
+    a.sin6_family = AF_INET6;
+    inet_pton(AF_INET6, text, &a.sin6_addr);
+    return is_loopback(reinterpret_cast<const sockaddr*>(&a));
+  };
+  EXPECT_TRUE(v4("127.0.0.1"));
+  EXPECT_TRUE(v4("127.0.0.2"));
+  EXPECT_TRUE(v4("127.255.0.9"));
+  EXPECT_FALSE(v4("0.0.0.0"));
+  EXPECT_FALSE(v4("10.0.0.1"));
+  EXPECT_FALSE(v4("128.0.0.1"));
+  EXPECT_TRUE(v6("::1"));
+  EXPECT_TRUE(v6("::ffff:127.0.0.3"));
+  EXPECT_FALSE(v6("::"));
+  EXPECT_FALSE(v6("::ffff:10.0.0.1"));
+
+  for (const char* host : {"127.0.0.2:8080", "127.0.0.1", "localhost:8080", "LOCALHOST",
+                           "[::1]:8080", "[::1]", "[::ffff:127.0.0.1]:8080"})
+    EXPECT_TRUE(loopback_host_header(host, 8080)) << host;
+  for (const char* host :
+       {"127.0.0.2:8081", "evil.example:8080", "evil.example", "", "127.0.0.1.evil.example", "::1",
+        "[::2]:8080", "10.0.0.1:8080", "127.1:8080", "localhost:", "localhost:08080"})
+    EXPECT_FALSE(loopback_host_header(host, 8080)) << host;
 }
 
 }  // namespace view_test

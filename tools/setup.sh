@@ -15,7 +15,7 @@ packages=(
   # MPI: `mpirun -np K nimbus render` (README, "Rendering on a cluster")
   libopenmpi-dev openmpi-bin
   # `nimbus view`: its web server, and the browser its tests drive (tests/browser/)
-  libcpp-httplib-dev chromium
+  libmicrohttpd-dev chromium
   # Embree 3: bench/embree_bvh, its kernels against our surface hierarchy (docs/benchmarks.md)
   libembree-dev
 )

@@ -1,8 +1,11 @@
 #pragma once
-// `nimbus view`'s web server (cpp-httplib): the viewer page and its two assets, the session's
-// state as JSON, its image as PNG, camera moves, and the film saved as EXR or PNG, and nothing
-// else: no file of the file system is served. Each request is small and bounded (a body of at
-// most 16 KiB, 5 s to read or write a request, a fixed pool of workers), and every handler
+// `nimbus view`'s web server (GNU libmicrohttpd, event-driven): the viewer page and its two
+// assets, the session's state as JSON, its image as PNG, camera moves, and the film saved as EXR
+// or PNG, and nothing else: no file of the file system is served. Connections cost a socket, not
+// a thread: a few threads watch them all (epoll) and run the handlers. Each request is small
+// and bounded: a body of at most 16 KiB, headers of at most 16 KiB, 5 s for the whole request to
+// arrive and 5 s for its answer to be taken, at most 256 connections and 128 from one address,
+// the stalest waiting one dropped for a newcomer (view/connection_table.h). Every handler
 // answers a malformed request with a 4xx and a one-line message, so that no client stalls the
 // render or the other clients.
 //
@@ -21,7 +24,8 @@ namespace nimbus {
 struct ViewServerOptions {
   std::string host = "127.0.0.1";
   int port = 8080;             // 0: any free port
-  int workers = 8;             // connections served at once; more wait for a worker
+  bool allow_remote = false;   // serve on an address other than the loopback
+  int workers = 4;             // threads that watch connections and run handlers
   std::string name = "scene";  // the scene's name on the page and in saved files' names
 };
 
@@ -29,8 +33,13 @@ class ViewServer {
  public:
   ViewServer(ViewSession& session, ViewServerOptions options);
   ~ViewServer();
-  // Binds to the host and port; returns the port. std::runtime_error("HOST:PORT: problem").
+  ViewServer(const ViewServer&) = delete;
+  ViewServer& operator=(const ViewServer&) = delete;
+  // Binds to the host and port; returns the port. std::runtime_error("HOST:PORT: problem"),
+  // also for an address beyond the loopback without allow_remote.
   int bind();
+  // Whether the bound address is the loopback's (bind() first).
+  bool loopback() const;
   // Serves until stop() (from another thread or a signal handler's watcher).
   void serve();
   void stop();

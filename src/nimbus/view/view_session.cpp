@@ -1,11 +1,10 @@
 #include "nimbus/view/view_session.h"
 
+#include <sys/stat.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <system_error>
 
 #include "nimbus/io/film_image.h"
 #include "nimbus/job/render_job.h"
@@ -77,13 +76,14 @@ bool ViewSession::wait(const std::function<bool(const ViewFrame&)>& until,
 }
 
 ViewSession::Stamp ViewSession::stamp(const std::string& path) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (ec || !std::filesystem::is_regular_file(status)) return {path, 0, -1};
-  const auto mtime = std::filesystem::last_write_time(path, ec);
-  const auto size = std::filesystem::file_size(path, ec);
-  if (ec) return {path, 0, -1};
-  return {path, int64_t(mtime.time_since_epoch().count()), int64_t(size)};
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return {path};
+  return {path,
+          int(st.st_mode & S_IFMT),
+          uint64_t(st.st_dev),
+          uint64_t(st.st_ino),
+          int64_t(st.st_mtim.tv_sec) * 1000000000 + st.st_mtim.tv_nsec,
+          int64_t(st.st_size)};
 }
 
 bool ViewSession::files_changed() const {

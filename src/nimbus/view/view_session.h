@@ -76,10 +76,15 @@ class ViewSession {
 
  private:
   using Clock = std::chrono::steady_clock;
+  // What a look at a file saw (following links): its kind, which file it is, its time and size.
+  // A file replaced by another, or by a FIFO, a directory or a device, stamps differently even
+  // when the old stamp was of a failed load, so that the page shows the new reason.
   struct Stamp {
     std::string path;
-    int64_t mtime = 0;
-    int64_t size = -1;  // -1: absent
+    int kind = -1;  // the stat mode's file type bits; -1: absent
+    uint64_t device = 0, inode = 0;
+    int64_t mtime = 0;  // nanoseconds
+    int64_t size = -1;
     bool operator==(const Stamp&) const = default;
   };
 

@@ -1,0 +1,13 @@
+#include "nimbus/view/camera_body.h"
+
+#include <string>
+
+#include "nimbus/scene/load.h"
+
+namespace nimbus {
+
+CameraDesc parse_camera_body(std::string_view body) {
+  return load_camera_json(parse_scene_text(std::string(body), "camera"), "camera");
+}
+
+}  // namespace nimbus
