@@ -67,12 +67,6 @@ SceneDesc load_scene_file(const std::string& path, const std::vector<std::string
 SceneDesc load_scene_text(const std::string& text, const std::string& source,
                           const std::vector<std::string>& overrides = {});
 
-// A scene file's text parsed with the scene loader's checks, for JSON from outside that is held
-// to the same rules (nimbus view's camera moves): UTF-8 without NUL bytes, no key twice in an
-// object, nesting at most kMaxJsonDepth, numbers within a double, comments allowed. SceneError
-// "SOURCE: problem", naming the JSON pointer where there is one.
-nlohmann::json parse_scene_text(const std::string& text, const std::string& source);
-
 // As load_scene_file for a document already parsed; `source` names it in messages.
 SceneDesc load_scene_json(nlohmann::json j, const std::string& source,
                           const std::vector<std::string>& overrides = {});

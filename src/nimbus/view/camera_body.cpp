@@ -7,7 +7,7 @@
 namespace nimbus {
 
 CameraDesc parse_camera_body(std::string_view body) {
-  return load_camera_json(parse_scene_text(std::string(body), "camera"), "camera");
+  return load_camera_json(parse_json_text(std::string(body), "camera"), "camera");
 }
 
 }  // namespace nimbus
