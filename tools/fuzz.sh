@@ -2,12 +2,14 @@
 # The fuzzers (docs/testing.md, "Fuzzing"): builds the libFuzzer targets in build-sanitize/
 # (clang, ASan, UBSan; tools/sanitize.sh shares that build; NIMBUS_FUZZ_BUILD=DIR builds in DIR
 # instead) and fuzzes from a committed corpus: the scene target from fuzz/corpus with the
-# scene-format dictionary fuzz/scene.dict, or with --vdb the VDB reader's target from
-# fuzz/vdb_corpus.
-#   tools/fuzz.sh [--vdb] [SECONDS] [JOBS]   fuzz for SECONDS (default 60) with JOBS processes
-#                                            (default 1); new inputs go to BUILD/fuzz-corpus (or
-#                                            BUILD/vdb-fuzz-corpus)
-#   tools/fuzz.sh [--vdb] --runs N [JOBS]    N inputs in all from fixed seeds (JOBS processes,
+# scene-format dictionary fuzz/scene.dict, with --vdb the VDB reader's target from
+# fuzz/vdb_corpus, or with --files the target of checkpoints, film files, .npy files and the
+# viewer's camera body from fuzz/files_corpus.
+#   tools/fuzz.sh [--vdb|--files] [SECONDS] [JOBS]   fuzz for SECONDS (default 60) with JOBS
+#                                            processes (default 1); new inputs go to
+#                                            BUILD/fuzz-corpus (or BUILD/vdb-fuzz-corpus,
+#                                            BUILD/files-fuzz-corpus)
+#   tools/fuzz.sh [--vdb|--files] --runs N [JOBS]   N inputs in all from fixed seeds (JOBS processes,
 #                                            default 1, process k with seed k and N / JOBS
 #                                            inputs), new inputs discarded: the deterministic
 #                                            check that tools/sanitize.sh runs
@@ -29,6 +31,13 @@ if [ "${1:-}" = "--vdb" ]; then
   # The corpus's files are at most 16 kB. No leak reports: OpenVDB leaks the nodes of a tree
   # whose reading threw (docs/testing.md).
   options=(-max_len=16384 -detect_leaks=0)
+elif [ "${1:-}" = "--files" ]; then
+  shift
+  target=nimbus_files_fuzz
+  corpus=fuzz/files_corpus
+  kept=files-fuzz-corpus
+  # The corpus's files are at most 8 kB.
+  options=(-max_len=8192)
 fi
 bash tools/configure.sh sanitize "$build"
 cmake --build "$build" -j"$(nproc)" --target "$target"

@@ -35,3 +35,4 @@ phase "sanitized configure" bash tools/configure.sh sanitize
 phase "sanitized build" cmake --build build-sanitize -j"$(nproc)"
 phase "sanitized tests" sanitized_tests
 phase "fuzzing" bash tools/fuzz.sh --runs 200000 "$(nproc)"
+phase "fuzzing the file readers" bash tools/fuzz.sh --files --runs 40000 "$(nproc)"

@@ -47,6 +47,17 @@ inline std::string checkpoint_bytes(const std::string& fingerprint, const std::s
   return b;
 }
 
+// A .npy file (version 1) whose header is the dictionary `header` as written, padded with spaces
+// and a newline as numpy pads it, followed by `data`.
+inline std::string npy_bytes(const std::string& header, const std::string& data) {
+  std::string text = header;
+  while ((10 + text.size() + 1) % 64 != 0) text += ' ';
+  text += '\n';
+  std::string b("\x93NUMPY\x01\x00", 8);
+  append(b, uint16_t(text.size()));
+  return b + text + data;
+}
+
 // JSON arrays nested `depth` deep.
 inline std::string nested_arrays(int depth) {
   return std::string(size_t(depth), '[') + std::string(size_t(depth), ']');
