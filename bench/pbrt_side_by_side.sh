@@ -3,7 +3,7 @@
 # time, MSE against each renderer's converged reference, efficiency 1/(MSE * time), and how
 # well the two renderers' references agree. The scenes in pbrt-v4's format are bench/pbrt/*.pbrt;
 # the driver is bench/pbrt/side_by_side.py; docs/benchmarks.md, "Against pbrt-v4", has the
-# method, the conventions matched and a run's table.
+# method and the current table, docs/benchmarks/pbrt-v4.md every run and the conventions matched.
 #
 #   PBRT=/path/to/pbrt bash bench/pbrt_side_by_side.sh [options] [scene...]
 #

@@ -33,8 +33,8 @@ struct Mode {
 };
 
 // Shadow rays are ratio-tracked unless the name says residual ratio tracking or ray marching, so
-// that the tables in docs/benchmarks.md, made before residual ratio tracking became the default,
-// compare.
+// that the tables in docs/benchmarks/tracking-modes.md, made before residual ratio tracking became
+// the default, compare.
 const std::vector<Mode> kModes = {
     {"delta",
      {"integrator.tracking=\"delta\"", "integrator.absorption=\"collide\"",

@@ -83,7 +83,7 @@ void for_each_medium_at(const S& scene, const Vec3& x, int inside, F&& f) {
           visit(scene.field_objects[k]);
       };
       // A short list is tested with branches: along a ray their outcomes repeat, and the branch
-      // predictor learns them (docs/benchmarks.md, "Box tests without branches").
+      // predictor learns them (docs/benchmarks/scenes-at-scale.md, "Box tests without branches").
       if (listed.size() <= kShortMemberList) {
         for (const std::int32_t k : listed)
           if (grid.objects[k].bounds.contains(x)) take(k);

@@ -53,9 +53,9 @@ inline constexpr double kSampledResidualFloor = 0.05;
 // over the leaves: fewer than majorant_samples per leaf in deep trees.
 inline constexpr size_t kOctreeSampleBudget = size_t{1} << 24;
 // What a density lookup costs in steps of the walk, for deciding which splits pay off. Measured
-// (docs/benchmarks.md, "Majorant octree"): a procedural cloud lookup about 100 ns against about
-// 10 ns per level of a walk's descent plus the tracker's work per segment; at 4 no depth of the
-// octree-depth experiment renders slower than a shallower one (at 16, depth 8 was 13 % slower
+// (docs/benchmarks/majorant-octree.md, "The walk"): a procedural cloud lookup about 100 ns against
+// about 10 ns per level of a walk's descent plus the tracker's work per segment; at 4 no depth of
+// the octree-depth experiment renders slower than a shallower one (at 16, depth 8 was 13 % slower
 // than depth 4).
 inline constexpr double kOctreeLookupCost = 4;
 // A field node listing more media objects than this is split further, past the requested depth

@@ -44,8 +44,8 @@ inline constexpr double kSeriesRoulette = 0.1;
 // The residual majorant's optical depth between two march points, and that of a chunk. On the
 // dense chromatic bench cloud, steps and chunks of 1/4, 2/2, 4/4, 4/8, 8/8 and 16/16 gave
 // efficiencies of 0.47, 0.60, 0.77, 0.72, 0.16 and 0.00 times delta tracking's (spectral-history;
-// docs/benchmarks.md): smaller steps cost lookups, larger ones make the marches so noisy that the
-// series' terms grow.
+// docs/benchmarks/shadow-ray-estimators.md): smaller steps cost lookups, larger ones make the
+// marches so noisy that the series' terms grow.
 struct MarchSettings {
   double step = 4;
   double chunk = 4;
