@@ -50,6 +50,7 @@ set(NIMBUS_PUBLIC_HEADERS
     scene/compile.h
     scene/input_file.h
     scene/json_reader.h
+    scene/json_text.h
     scene/load.h
     scene/scene_desc.h
     spectral/planck.h

@@ -11,7 +11,7 @@
 #include "nimbus/io/atomic_file.h"
 #include "nimbus/io/film_file.h"
 #include "nimbus/os/regular_file.h"
-#include "nimbus/scene/load.h"
+#include "nimbus/scene/json_text.h"
 
 namespace nimbus {
 
@@ -21,7 +21,7 @@ constexpr char kMagic[8] = {'N', 'I', 'M', 'C', 'K', 'P', 'T', '\0'};
 // 2: a CRC-32 of everything before it ends the file, so that a damaged checkpoint is refused
 // rather than resumed (issue 29: one flipped byte of a pixel gave an image mean of -5e12).
 constexpr uint32_t kVersion = 2;
-constexpr uint32_t kMaxFingerprintBytes = 64u << 20;  // a scene file's limit (scene/load.h)
+constexpr uint32_t kMaxFingerprintBytes = 64u << 20;  // a scene file's limit (scene/json_text.h)
 
 // zlib's CRC-32 of the `length` bytes from the stream's start (the stream is left after them).
 uint32_t crc32_of(std::istream& in, uint64_t length, const std::string& path) {

@@ -1,32 +1,25 @@
 #pragma once
-// Loading a scene file (docs/scene-format.md) into a SceneDesc. All validation happens here:
+// Loading a scene file (docs/scene-format.md) into a SceneDesc, its JSON read through
+// scene/json_text.h (file checks, parsing with limits, --set). All validation happens here:
 // every error is a SceneError whose message is one line, "SOURCE: /json/pointer: problem", where
 // SOURCE is the file name, or the "--set KEY=VALUE" flag that put the offending value in place.
 
-#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "nimbus/math/mat4.h"
 #include "nimbus/scene/json_reader.h"
+#include "nimbus/scene/json_text.h"
 #include "nimbus/scene/scene_desc.h"
 
 namespace nimbus {
 
-// Reads, parses (comments allowed), applies the overrides in order and validates.
 // How deeply shapes may nest in a scene file (docs/scene-format.md).
 inline constexpr int kMaxShapeDepth = 256;
 
-// How deeply arrays and objects may nest in a scene file's JSON (or a --set value), checked while
-// parsing: room for kMaxShapeDepth levels of shapes (two JSON levels each: a node and its list of
-// children) and the sections around them. Deeper documents are refused before they cost memory
-// in proportion to the square of their depth (issue 29: 200 000 nested arrays took 24 GB).
-inline constexpr int kMaxJsonDepth = 4 * kMaxShapeDepth;
-
-// The largest scene file read: far above any scene written by hand or exported, far below
-// what would exhaust memory.
-inline constexpr std::uintmax_t kMaxSceneFileBytes = std::uintmax_t{64} << 20;
+static_assert(kMaxJsonDepth >= 4 * kMaxShapeDepth,
+              "the JSON depth limit (scene/json_text.h) must leave room for the deepest shapes");
 
 // Points, directions and lengths (a position, a radius, a translation) lie within ±1e100: their
 // squares and products, which the quadrics and the camera compute, stay within a double
@@ -50,13 +43,6 @@ inline const Range kEmission = between(0, kMaxEmission);
 // (frep/intersect.cpp) keeps its roots to 1e-6 there and lost them from about 1e30 (issue 29:
 // weights of 1e50 speckled the surface, 1.7e308 made holes and NaN).
 inline constexpr double kMaxPerturbationWeight = 1e15;
-
-// JSON text parsed as a scene file is, with its limits (comments allowed; UTF-8 without NUL bytes;
-// no key twice in an object; at most `max_depth` levels; numbers within a double): every problem
-// is one SceneError, "SOURCE: problem" or "SOURCE: /json/pointer: problem". For any JSON nimbus
-// reads from outside (a checkpoint's fingerprint, the viewer's requests).
-nlohmann::json parse_json_text(const std::string& text, const std::string& source,
-                               int max_depth = kMaxJsonDepth);
 
 // Reads, parses and validates a scene file; every problem is one SceneError line naming the
 // file and, inside it, the JSON path.
@@ -88,13 +74,5 @@ Mat4 read_transform(const JsonValue& v);
 // What is wrong with a transform placing a shape, or "": an entry beyond ±kMaxCoordinate (or not
 // finite), or a determinant that overflows or is degenerate (|det| <= 1e-12).
 std::string transform_problem(const Mat4& m);
-
-// Applies one `--set KEY=VALUE`: KEY is a dotted path into the document (array elements by
-// index, as in lights.0.radiance), VALUE is parsed as JSON or else taken as a string. Missing
-// object keys along the path are created; a path through a value that is neither an object nor
-// an array, or past the end of an array, is an error "--set KEY=VALUE: problem" (a long value
-// cut short). Returns the JSON pointer of what the override owns, which later messages blame on
-// it: the outermost key it created, or else the value it set.
-std::string apply_override(nlohmann::json& j, const std::string& key_equals_value);
 
 }  // namespace nimbus

@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "nimbus/scene/json_text.h"
 #include "nimbus/scene/load.h"
 
 namespace nimbus {

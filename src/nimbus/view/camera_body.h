@@ -1,7 +1,8 @@
 #pragma once
 // The body of `nimbus view`'s POST /camera: a scene file's "camera" value, read as a scene file
-// is read (scene/load.h: parse_json_text, load_camera_json), so that the server holds its own
-// input to the scene format's rules. A pure function of the bytes, for the fuzzer.
+// is read (scene/json_text.h: parse_json_text; scene/load.h: load_camera_json), so that the
+// server holds its own input to the scene format's rules. A pure function of the bytes, for the
+// fuzzer.
 
 #include <string_view>
 
