@@ -10,9 +10,8 @@
 #include <cstring>
 #include <optional>
 
-#include "nimbus/scene/npy_header.h"
-
 #include "nimbus/os/regular_file.h"
+#include "nimbus/scene/npy_header.h"
 
 namespace nimbus {
 namespace {
