@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_args.h"
 #include "nimbus/render/light_tree.h"
 #include "nimbus/render/renderer.h"
 #include "nimbus/scene/compile.h"
@@ -102,19 +103,11 @@ void bench(int n, int spp, int ref_spp, int reps, int threads) {
 int main(int argc, char** argv) {
   int spp = 16, ref_spp = 1024, reps = 3, threads = 1;
   std::vector<int> counts;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--spp" && i + 1 < argc)
-      spp = std::stoi(argv[++i]);
-    else if (a == "--ref-spp" && i + 1 < argc)
-      ref_spp = std::stoi(argv[++i]);
-    else if (a == "--reps" && i + 1 < argc)
-      reps = std::max(1, std::stoi(argv[++i]));
-    else if (a == "--threads" && i + 1 < argc)
-      threads = std::max(1, std::stoi(argv[++i]));
-    else
-      counts.push_back(std::stoi(a));
-  }
+  bench_args::parse_args(
+      argc, argv,
+      {bench_args::int_flag("--spp", spp), bench_args::int_flag("--ref-spp", ref_spp),
+       bench_args::int_flag("--reps", reps, 1), bench_args::int_flag("--threads", threads, 1)},
+      [&](const char* a) { counts.push_back(std::stoi(a)); });
   if (counts.empty()) counts = {16, 64, 256, 1024, 4096};
   std::printf(
       "| lights | choice | time (s) | MSE | efficiency vs per-light |\n|---|---|---|---|---|\n");

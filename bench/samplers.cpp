@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_args.h"
 #include "nimbus/render/path_sampler.h"
 #include "nimbus/render/renderer.h"
 #include "nimbus/scene/compile.h"
@@ -80,21 +81,12 @@ double sampler_ns_per_sample(RenderSettings::Sampler kind, int bounces) {
 int main(int argc, char** argv) {
   int spp = 16, ref_spp = 1024, reps = 5, width = 48;
   std::vector<std::string> scenes, overrides;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--spp" && i + 1 < argc)
-      spp = std::stoi(argv[++i]);
-    else if (a == "--ref-spp" && i + 1 < argc)
-      ref_spp = std::stoi(argv[++i]);
-    else if (a == "--reps" && i + 1 < argc)
-      reps = std::stoi(argv[++i]);
-    else if (a == "--width" && i + 1 < argc)
-      width = std::stoi(argv[++i]);
-    else if (a == "--set" && i + 1 < argc)
-      overrides.push_back(argv[++i]);
-    else
-      scenes.push_back(a);
-  }
+  bench_args::parse_args(
+      argc, argv,
+      {bench_args::int_flag("--spp", spp), bench_args::int_flag("--ref-spp", ref_spp),
+       bench_args::int_flag("--reps", reps), bench_args::int_flag("--width", width),
+       bench_args::list_flag("--set", overrides)},
+      [&](const char* a) { scenes.push_back(a); });
   if (scenes.empty()) scenes.push_back(std::string(NIMBUS_SOURCE_DIR) + "/scenes/cloud.json");
   RenderOptions one_thread;
   one_thread.threads = 1;

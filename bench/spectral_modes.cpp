@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_args.h"
 #include "nimbus/render/renderer.h"
 #include "nimbus/render/setting_names.h"
 #include "nimbus/scene/compile.h"
@@ -44,21 +45,17 @@ int main(int argc, char** argv) {
   int spp = 8, reps = 3, width = 160;
   std::vector<int> wavelengths = {4, 8};
   std::string scene_path = std::string(NIMBUS_SOURCE_DIR) + "/scenes/cloud.json";
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--spp" && i + 1 < argc)
-      spp = std::stoi(argv[++i]);
-    else if (a == "--reps" && i + 1 < argc)
-      reps = std::stoi(argv[++i]);
-    else if (a == "--width" && i + 1 < argc)
-      width = std::stoi(argv[++i]);
-    else if (a == "--wavelengths" && i + 1 < argc) {
-      wavelengths.clear();
-      std::stringstream list(argv[++i]);
-      for (std::string n; std::getline(list, n, ',');) wavelengths.push_back(std::stoi(n));
-    } else
-      scene_path = a;
-  }
+  const auto set_wavelengths = [&](const char* v) {
+    wavelengths.clear();
+    std::stringstream list(v);
+    for (std::string n; std::getline(list, n, ',');) wavelengths.push_back(std::stoi(n));
+  };
+  bench_args::parse_args(argc, argv,
+                         {bench_args::int_flag("--spp", spp),
+                          bench_args::int_flag("--reps", reps),
+                          bench_args::int_flag("--width", width),
+                          {"--wavelengths", set_wavelengths}},
+                         [&](const char* a) { scene_path = a; });
   std::vector<std::string> names = {"rgb"};
   std::vector<Mode> modes = {{"", {"spectrum.mode=\"rgb\""}, {}}};
   for (int n : wavelengths) {

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_args.h"
 #include "nimbus/render/renderer.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
@@ -157,19 +158,11 @@ int main(int argc, char** argv) {
   int spp = 16, ref_spp = 512, reps = 3;
   std::string cache = "build/bench-cache";
   std::vector<std::string> scenes;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--spp" && i + 1 < argc)
-      spp = std::stoi(argv[++i]);
-    else if (a == "--ref-spp" && i + 1 < argc)
-      ref_spp = std::stoi(argv[++i]);
-    else if (a == "--reps" && i + 1 < argc)
-      reps = std::max(1, std::stoi(argv[++i]));
-    else if (a == "--cache" && i + 1 < argc)
-      cache = argv[++i];
-    else
-      scenes.push_back(a);
-  }
+  bench_args::parse_args(
+      argc, argv,
+      {bench_args::int_flag("--spp", spp), bench_args::int_flag("--ref-spp", ref_spp),
+       bench_args::int_flag("--reps", reps, 1), bench_args::string_flag("--cache", cache)},
+      [&](const char* a) { scenes.push_back(a); });
   if (scenes.empty())
     for (const char* s : {"chromatic_cloud", "marble", "skin", "haze"})
       scenes.push_back(std::string("scenes/bench/") + s + ".json");

@@ -30,7 +30,9 @@ import time
 
 import numpy as np
 
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import (LUMINANCE, REPO, RenderFailed, block_sums, log, nimbus_command,
+                     pbrt_command, read_exr, run_timed)
+
 HERE = os.path.join(REPO, "bench", "pbrt")
 
 # nimbus settings: (label, overrides)
@@ -65,33 +67,6 @@ SCENES = {
 }
 
 
-def log(msg):
-    print(msg, file=sys.stderr, flush=True)
-
-
-def read_pfm(path):
-    with open(path, "rb") as f:
-        assert f.readline().strip() == b"PF"
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        data = np.fromfile(f, dtype="<f4" if scale < 0 else ">f4", count=w * h * 3)
-    return data.reshape(h, w, 3)[::-1].astype(np.float64)  # top row first
-
-
-def run_timed(cmd, cwd, log_path):
-    """Runs cmd (output to log_path); returns (CPU seconds of the child, wall seconds)."""
-    with open(log_path, "wb") as logf:
-        t0 = time.perf_counter()
-        p = subprocess.Popen(cmd, cwd=cwd, stdout=logf, stderr=subprocess.STDOUT)
-        _, status, ru = os.wait4(p.pid, 0)
-        wall = time.perf_counter() - t0
-        p.returncode = os.waitstatus_to_exitcode(status)
-    if p.returncode != 0:
-        sys.exit("command failed (exit %d): %s\n%s" % (
-            p.returncode, " ".join(cmd), open(log_path, errors="replace").read()[-2000:]))
-    return ru.ru_utime + ru.ru_stime, wall
-
-
 class Ctx:
     def __init__(self, a):
         self.a = a
@@ -102,26 +77,21 @@ class Ctx:
         os.makedirs(self.refs, exist_ok=True)
         self.exr_to_pfm = a.exr_to_pfm
 
-    def to_array(self, exr):
-        pfm = exr[:-4] + ".pfm"
-        subprocess.run([self.exr_to_pfm, exr, pfm], check=True)
-        return read_pfm(pfm)
-
     # One render; returns (image, cpu seconds, wall seconds, stats or None).
     def render(self, r, spp, seed, threads, tag):
         exr = os.path.join(self.tmp, tag + ".exr")
         if r["renderer"] == "nimbus":
             stats = os.path.join(self.tmp, tag + ".json")
-            cmd = [self.a.nimbus, "render", r["scene"], "-o", exr, "--spp", str(spp),
-                   "--seed", str(seed), "--threads", str(threads), "--quiet", "--stats", stats]
-            for o in r["overrides"]:
-                cmd += ["--set", o]
+            cmd = nimbus_command(self.a.nimbus, r["scene"], exr, spp, seed, threads, stats,
+                                 r["overrides"])
         else:
             stats = None
-            cmd = [self.a.pbrt, "--nthreads", str(threads), "--spp", str(spp), "--seed",
-                   str(seed), "--outfile", exr, "--quiet", r["scene"]]
-        cpu, wall = run_timed(cmd, self.out, os.path.join(self.tmp, tag + ".log"))
-        img = self.to_array(exr)
+            cmd = pbrt_command(self.a.pbrt, r["scene"], exr, spp, seed, threads, False)
+        try:
+            cpu, wall, _ = run_timed(cmd, self.out, os.path.join(self.tmp, tag + ".log"), 2000)
+        except RenderFailed as e:
+            sys.exit("command failed (exit %d): %s\n%s" % (e.code, " ".join(e.cmd), e.log_tail))
+        img = read_exr(self.exr_to_pfm, exr)
         st = json.load(open(stats)) if stats else None
         return img, cpu, wall, st
 
@@ -196,12 +166,10 @@ def block_compare(ref_a, var_a, ref_b, var_b, block):
     estimates, channels taken as independent). z-scores would mislead: where a pixel sees only
     the sky, its variance is near 0 and the renderers' RGB-to-spectrum round trips (pbrt's
     within about 1e-4) dominate."""
-    h, w, _ = ref_a.shape
     def blocks(x):
-        return x[: h // block * block, : w // block * block].reshape(
-            h // block, block, w // block, block, 3).sum(axis=(1, 3))
+        return block_sums(x, block)
     n = block * block
-    wl = np.array([0.2126, 0.7152, 0.0722])
+    wl = LUMINANCE
     la, lb = (blocks(ref_a) / n) @ wl, (blocks(ref_b) / n) @ wl
     noise = np.sqrt((blocks(var_a) / n ** 2 + blocks(var_b) / n ** 2) @ (wl ** 2))
     rel = (lb - la) / np.maximum(la, 1e-6)

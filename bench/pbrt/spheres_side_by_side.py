@@ -29,8 +29,9 @@ SPP less those at 1 spp: nimbus --stats counters.surface_rays + counters.shadow_
 --stats "Regular ray intersection tests" + "Shadow ray intersection tests" (camera rays are
 among the closest-hit queries in both); rays/s = rays / render CPU time. Medians over the
 repetitions (of the per-repetition differences). SPP, unless given, is the smallest power of
-two at which every configuration's render part is at least --min-render seconds, from a
-calibration run at 1 and 16 spp.
+two (at most 65 536) at which every configuration's render part is at least --min-render
+seconds, from calibration runs at 1 spp and at 16 spp, raised x4 (to at most 4096) until the
+render part is half of --min-render.
 
 The image means (R, G, B) of the SPP renders, averaged over the repetitions, are printed for
 both renderers: a gross mismatch means the scenes differ (exit 1 when any channel differs by
@@ -60,7 +61,6 @@ import statistics
 import subprocess
 import sys
 import tempfile
-import time
 
 try:
     import numpy as np
@@ -69,7 +69,9 @@ except ImportError:
           file=sys.stderr)
     sys.exit(2)
 
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from harness import (LUMINANCE, REPO, RenderFailed, block_sums, log, nimbus_command,
+                     pbrt_command, read_exr, run_timed)
+
 BENCH_SCALE = os.path.join(REPO, "tools", "bench_scale.py")
 EXR_TO_PFM_SRC = os.path.join(REPO, "bench", "pbrt", "exr_to_pfm.cpp")
 
@@ -83,10 +85,6 @@ MODES = {
 def die(msg, code=2):
     print("spheres_side_by_side: " + msg, file=sys.stderr)
     sys.exit(code)
-
-
-def log(msg):
-    print(msg, file=sys.stderr, flush=True)
 
 
 def load_bench_scale():
@@ -209,32 +207,14 @@ def to_pbrt(scene, image_name):
 # running
 
 
-def read_pfm(path):
-    with open(path, "rb") as f:
-        if f.readline().strip() != b"PF":
-            raise ValueError("%s is not a colour PFM" % path)
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        data = np.fromfile(f, dtype="<f4" if scale < 0 else ">f4", count=w * h * 3)
-    return data.reshape(h, w, 3)[::-1].astype(np.float64)
-
-
-def run_timed(cmd, cwd, log_path):
-    """Runs cmd with output to log_path; returns CPU seconds (user + system), wall seconds and
-    peak resident MiB of the child."""
-    with open(log_path, "wb") as logf:
-        t0 = time.perf_counter()
-        try:
-            p = subprocess.Popen(cmd, cwd=cwd, stdout=logf, stderr=subprocess.STDOUT)
-        except OSError as e:
-            die("cannot run %s: %s" % (cmd[0], e.strerror))
-        _, status, ru = os.wait4(p.pid, 0)
-        wall = time.perf_counter() - t0
-    code = os.waitstatus_to_exitcode(status)
-    if code != 0:
-        tail = open(log_path, errors="replace").read()[-1500:]
-        die("render failed (exit %d): %s\n%s" % (code, " ".join(cmd), tail), 1)
-    return ru.ru_utime + ru.ru_stime, wall, ru.ru_maxrss / 1024
+def run_timed_or_die(cmd, cwd, log_path):
+    """harness.run_timed, its failures told as this script's exit statuses."""
+    try:
+        return run_timed(cmd, cwd, log_path, 1500)
+    except RenderFailed as e:
+        die("render failed (exit %d): %s\n%s" % (e.code, " ".join(e.cmd), e.log_tail), 1)
+    except OSError as e:
+        die("cannot run %s: %s" % (cmd[0], e.strerror))
 
 
 PBRT_COUNTERS = {"Regular ray intersection tests": "surface_rays",
@@ -265,15 +245,11 @@ class Runner:
         exr, log_path = base + ".exr", base + ".log"
         if config["renderer"] == "nimbus":
             stats = base + ".json"
-            cmd = [self.a.nimbus, "render", config["scene"][n], "-o", exr, "--spp", str(spp),
-                   "--seed", str(seed), "--threads", "1", "--quiet", "--stats", stats,
-                   "--set", 'integrator.sampler="zsobol"']
-            for o in config["overrides"]:
-                cmd += ["--set", o]
+            cmd = nimbus_command(self.a.nimbus, config["scene"][n], exr, spp, seed, 1, stats,
+                                 ['integrator.sampler="zsobol"'] + config["overrides"])
         else:
-            cmd = [self.a.pbrt, "--nthreads", "1", "--spp", str(spp), "--seed", str(seed),
-                   "--outfile", exr, "--quiet", "--stats", config["scene"][n]]
-        cpu, wall, rss = run_timed(cmd, self.work, log_path)
+            cmd = pbrt_command(self.a.pbrt, config["scene"][n], exr, spp, seed, 1, True)
+        cpu, wall, rss = run_timed_or_die(cmd, self.work, log_path)
         r = {"cpu": cpu, "wall": wall, "rss": rss, "cmd": cmd}
         if config["renderer"] == "nimbus":
             st = json.load(open(stats))
@@ -285,9 +261,7 @@ class Runner:
         c = r["counters"]
         r["rays"] = (c["surface_rays"] + c["shadow_rays"]
                      if "surface_rays" in c and "shadow_rays" in c else None)
-        pfm = base + ".pfm"
-        subprocess.run([self.a.exr_to_pfm, exr, pfm], check=True)
-        img = read_pfm(pfm)
+        img = read_exr(self.a.exr_to_pfm, exr)
         r["mean"] = img.mean(axis=(0, 1)).tolist()
         r["image"] = img
         return r
@@ -297,11 +271,8 @@ def block_difference(a, b, block=8):
     """Relative rms and largest difference of the luminance of block x block pixel blocks of
     image b against image a, over the blocks brighter than a tenth of a's brightest: a
     mirrored or shifted scene shows here where the image means may agree."""
-    h, w, _ = a.shape
     def blocks(x):
-        x = x[: h // block * block, : w // block * block]
-        return x.reshape(h // block, block, w // block, block, 3).mean(axis=(1, 3)) @ \
-            np.array([0.2126, 0.7152, 0.0722])
+        return (block_sums(x, block) / (block * block)) @ LUMINANCE
     la, lb = blocks(a), blocks(b)
     bright = la > 0.1 * la.max()
     rel = (lb - la)[bright] / la[bright]
@@ -310,6 +281,29 @@ def block_difference(a, b, block=8):
 
 def pow2_at_least(x):
     return 1 << max(0, math.ceil(math.log2(max(x, 1))))
+
+
+# Calibration renders: 1 spp, then CAL_FIRST_SPP, raised x4 up to CAL_LAST_SPP until the render
+# part (the difference) is half of --min-render. Where the set-up dominates (N = 65 536: two
+# 1-spp runs 0.18 s apart, 16 spp only 0.09 s above 1 spp) a 16-spp difference is noise; it
+# once fell to its floor and calibrated 65 536 spp. MAX_SPP bounds what a bad calibration costs.
+CAL_FIRST_SPP, CAL_LAST_SPP, MAX_SPP = 16, 4096, 65536
+
+
+def calibrate(runner, configs, n, min_render):
+    """The smallest power of two (8 to MAX_SPP) at which every configuration's render part is
+    1.25 x min_render, from each one's CPU cost per spp."""
+    per_spp = []
+    for c in configs:
+        one = runner.render(c, n, 1, 1, "cal-1spp")["cpu"]
+        spp = CAL_FIRST_SPP
+        while True:
+            part = runner.render(c, n, spp, 1, "cal-%dspp" % spp)["cpu"] - one
+            if part >= min_render / 2 or spp >= CAL_LAST_SPP:
+                break
+            spp *= 4
+        per_spp.append(max(part, 1e-3) / (spp - 1))
+    return min(MAX_SPP, max(8, pow2_at_least(1 + 1.25 * min_render / min(per_spp))))
 
 
 def loadavg():
@@ -405,13 +399,8 @@ def main():
             c["scene"][n] = nscene if c["renderer"] == "nimbus" else pscene
         load_start = loadavg()
         spp = a.spp
-        if spp is None:  # calibration: the render part's cost per spp of each configuration
-            per_spp = []
-            for c in configs:
-                r1 = runner.render(c, n, 1, 1, "cal-1spp")
-                r16 = runner.render(c, n, 16, 1, "cal-16spp")
-                per_spp.append(max(r16["cpu"] - r1["cpu"], 1e-3) / 15)
-            spp = max(8, pow2_at_least(1 + 1.25 * a.min_render / min(per_spp)))
+        if spp is None:
+            spp = calibrate(runner, configs, n, a.min_render)
         log("N = %d: %d spp, %d repetitions (load %s)" % (n, spp, a.reps, load_start))
         runs = {c["key"]: [] for c in configs}
         for rep in range(a.reps):
