@@ -1,11 +1,12 @@
 // Argument handling shared by the bench programs: "--flag VALUE" pairs, anything else is a
-// positional argument. A flag given last, without its value, is taken as a positional argument,
-// and a value that is not a number ends the program through std::stoi's exception: these are
-// developer tools, and their behaviour is kept as it was before they shared this file.
+// positional argument. A flag without its value, or an integer flag whose value is not an
+// integer, is one line on stderr and exit 2, as for the nimbus command line.
 #pragma once
 
 #include <algorithm>
 #include <climits>
+#include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <initializer_list>
 #include <string>
@@ -18,9 +19,25 @@ struct Flag {
   std::function<void(const char*)> set;  // called with the flag's value
 };
 
+[[noreturn]] inline void fail(const std::string& message) {
+  std::fprintf(stderr, "%s\n", message.c_str());
+  std::exit(2);
+}
+
 // An integer flag, raised to at least `min`.
 inline Flag int_flag(const char* name, int& value, int min = INT_MIN) {
-  return {name, [&value, min](const char* v) { value = std::max(min, std::stoi(v)); }};
+  return {name, [&value, min, name](const char* v) {
+            size_t used = 0;
+            try {
+              const int n = std::stoi(v, &used);
+              if (v[used] == '\0') {
+                value = std::max(min, n);
+                return;
+              }
+            } catch (const std::exception&) {
+            }
+            fail(std::string(name) + ": expected an integer, not \"" + v + "\"");
+          }};
 }
 
 inline Flag string_flag(const char* name, std::string& value) {
@@ -38,7 +55,8 @@ inline void parse_args(int argc, char** argv, std::initializer_list<Flag> flags,
     const std::string a = argv[i];
     const Flag* flag = nullptr;
     for (const Flag& f : flags)
-      if (a == f.name && i + 1 < argc) flag = &f;
+      if (a == f.name) flag = &f;
+    if (flag && i + 1 == argc) fail(a + " needs a value");
     if (flag)
       flag->set(argv[++i]);
     else
