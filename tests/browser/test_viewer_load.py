@@ -66,9 +66,13 @@ def connect(port):
 
 
 def settled_figures(v, baseline, what):
-    """Waits until the viewer holds no more descriptors than at `baseline`; its figures then."""
+    """Waits until the viewer holds no more descriptors than at `baseline`, and asserts it runs
+    as many threads; returns its figures then, and them beside the baseline's as text."""
     wait_until(lambda: process_figures(v.process.pid)[0] <= baseline[0], what)
-    return process_figures(v.process.pid)
+    fds, threads, rss = process_figures(v.process.pid)
+    assert threads == baseline[1]
+    return (fds, threads, rss), (f"descriptors {baseline[0]} -> {fds}, threads {baseline[1]} -> "
+                                 f"{threads}, RSS {baseline[2]} -> {rss} KiB")
 
 
 def test_slow_and_idle_clients_do_not_lock_others_out(tmp_path):
@@ -124,11 +128,9 @@ def test_slow_and_idle_clients_do_not_lock_others_out(tmp_path):
         kept = sum(map(open_socket, crowd))
         for s in crowd:
             s.close()
-        fds, threads, rss = settled_figures(v, baseline, "the connections closed")
-        assert threads == baseline[1]
+        _, text = settled_figures(v, baseline, "the connections closed")
         print(f"GET /state with 300 idle connections opened: {crowded * 1e3:.1f} ms, {kept} kept; "
-              f"descriptors {baseline[0]} -> {fds}, threads {baseline[1]} -> {threads}, "
-              f"RSS {baseline[2]} -> {rss} KiB")
+              f"{text}")
     finally:
         code, err = v.stop()
     assert code == 0 and err == "", err
@@ -179,11 +181,8 @@ def test_garbage_pipelining_and_clients_that_leave(tmp_path):
             s.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, b"\x01\x00\x00\x00\x00\x00\x00\x00")
             s.close()
         assert timed_state(v.port)[0] == 200
-        fds, threads, rss = settled_figures(v, baseline, "the connections closed")
-        assert threads == baseline[1]
-        print(f"\nafter {len(garbage)} garbage requests, 51 pipelined and 20 left mid-answer: "
-              f"descriptors {baseline[0]} -> {fds}, threads {baseline[1]} -> {threads}, "
-              f"RSS {baseline[2]} -> {rss} KiB")
+        _, text = settled_figures(v, baseline, "the connections closed")
+        print(f"\nafter {len(garbage)} garbage requests, 51 pipelined and 20 left mid-answer: {text}")
     finally:
         code, err = v.stop()
     assert code == 0 and err == "", err
@@ -230,8 +229,7 @@ def test_a_thousand_saves_grow_nothing(tmp_path):
               f"{figures}")
         # Nothing grows: no more descriptors and the same threads at the end as before the
         # saves, and memory within a generous margin of it (the allocator keeps some).
-        fds, threads, rss = settled_figures(v, figures[0], "the files closed")
-        assert threads == figures[0][1]
+        (_, _, rss), _ = settled_figures(v, figures[0], "the files closed")
         assert rss < figures[0][2] * 1.5 + 16384
     finally:
         code, err = v.stop()
