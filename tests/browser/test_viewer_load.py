@@ -4,7 +4,7 @@ garbage, pipelined requests and clients that leave mid-answer leave nothing behi
 file saved 1 000 times grows nothing, and a signal ends the viewer even while a load is stuck.
 Timings are printed (pytest -s), never asserted: docs/benchmarks.md ("The viewer") has them.
 
-    NIMBUS_EXE=build/nimbus python3 -m pytest -s tests/browser/test_viewer_load.py
+    NIMBUS_EXE=build/nimbus /usr/bin/python3 -m pytest -s tests/browser/test_viewer_load.py
 """
 import http.client
 import os
