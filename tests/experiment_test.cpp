@@ -157,7 +157,8 @@ TEST_F(Experiment, ScatterDistanceQuick) {
   }
 }
 
-// Sec. 4: in the translucent objects (homogeneous media, no shadow rays inside a dielectric) delta
+// Sec. 4: in the translucent objects (homogeneous media; the experiment sends no shadow rays from
+// inside a dielectric, integrator.manifold false) delta
 // tracking's per-channel majorant is exact, so every segment is a scattering event; spectral
 // tracking samples at the largest extinction over channels and so takes more segments per event.
 TEST_F(Experiment, SegmentsQuick) {

@@ -22,8 +22,9 @@ RenderResult render_file(const std::filesystem::path& file, const Size& size, ui
       {fmt::format("film.width={}", size.width), fmt::format("film.height={}", size.height),
        fmt::format("integrator.spp={}", size.spp), fmt::format("integrator.seed={}", seed),
        "integrator.tracking=" + tracking,
-       // Ratio-tracked shadow rays, as when docs/reproduction.md's figures were measured.
-       "integrator.transmittance=ratio"}));
+       // Ratio-tracked shadow rays, as when docs/reproduction.md's figures were measured, and no
+       // manifold sampling: Sec. 4 counts the segments of free paths, not of shadow rays.
+       "integrator.transmittance=ratio", "integrator.manifold=false"}));
   RenderOptions options;
   options.threads = threads;
   return render(scene, options);

@@ -7,6 +7,22 @@
 
 namespace nimbus {
 
+// Manifold next-event estimation (render/manifold.h).
+struct ManifoldCounters {
+  uint64_t walks = 0;         // chains sought by next-event estimation
+  uint64_t found = 0;         // of which converged to a valid chain
+  uint64_t newton_steps = 0;  // Newton iterations over all walks
+  uint64_t checks = 0;        // walks repeated to decide whether a sampled path is the walk's
+
+  ManifoldCounters& operator+=(const ManifoldCounters& o) {
+    walks += o.walks;
+    found += o.found;
+    newton_steps += o.newton_steps;
+    checks += o.checks;
+    return *this;
+  }
+};
+
 struct Counters {
   uint64_t paths = 0;
   uint64_t surface_rays = 0;  // closest-hit queries
@@ -17,6 +33,7 @@ struct Counters {
   uint64_t rejected_samples = 0;   // NaN or infinite sample values the film refused (film.h)
   uint64_t shadow_lookups = 0;     // the shadow rays' share of tracking.lookups
   TrackingCounters tracking;       // tentative collisions, density lookups, clamped probabilities
+  ManifoldCounters manifold;
 
   uint64_t null_collisions() const { return tracking.tentative_collisions - real_collisions; }
 
@@ -30,6 +47,7 @@ struct Counters {
     rejected_samples += o.rejected_samples;
     shadow_lookups += o.shadow_lookups;
     tracking += o.tracking;
+    manifold += o.manifold;
     return *this;
   }
 };

@@ -17,6 +17,7 @@
 #include "nimbus/render/counters.h"
 #include "nimbus/render/first_vertex.h"
 #include "nimbus/render/light_choice.h"
+#include "nimbus/render/manifold_light.h"
 #include "nimbus/render/path_sampler.h"
 #include "nimbus/render/path_spectra.h"
 #include "nimbus/render/sampling.h"
@@ -27,8 +28,6 @@
 
 namespace nimbus {
 namespace integrator_detail {
-
-inline constexpr double kShadowShrink = 1 - 1e-7;
 
 // One light sample for next-event estimation at p, from the 2D number u, with the scattering
 // function's value there and the shadow ray's origin; none if the light cannot contribute.
@@ -72,21 +71,46 @@ double light_sampling_pdf(const Scene& scene, const PathSpectra<N>& ps, int i, c
              : 1.0;
 }
 
-// Light reaching p by next-event estimation, times the scattering function `f(wi)` (cosine
-// included for surfaces) and the policy's weight for the shadow ray (its transmittance, and MIS
-// with the sampling of f): one sample of every light, or of one light picked by its fluence at p
-// (light_choice.h), divided by the probability of the pick. A light's numbers come from its slot
-// in the block of `bounce` (SampleDims::light; the picked light takes slot 0, the pick slot 1).
+// Light reaching the vertex `at` by next-event estimation, times the scattering function
+// `f(wi)` (cosine included for surfaces) and the policy's weight for the shadow ray (its
+// transmittance, and MIS with the sampling of f): one sample of every light, or of one light
+// picked by its fluence at the vertex (light_choice.h), divided by the probability of the pick.
+// A light's numbers come from its slot in the block of `bounce` (SampleDims::light; the picked
+// light takes slot 0, the pick slot 1). With `manifold`, a sample whose straight shadow ray
+// leaves the solid the vertex is in, or meets a dielectric solid first, is joined to the light
+// through that solid's boundary instead (render/manifold_light.h); without it, a vertex inside a
+// solid has no next-event estimation (its boundary is specular), and the caller skips it.
 template <int N, class Policy, class F, class Pdf>
-Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Vec3& p, const Vec3& n,
-                         bool on_surface, int inside, const Policy& policy, F&& f, Pdf&& f_pdf,
+Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const ChainStart& at,
+                         int depth, bool manifold, const Policy& policy, F&& f, Pdf&& f_pdf,
                          PathSampler& sampler, uint32_t bounce, Counters& counters) {
   Spectrum<N> L(0.0);
   // Light i from slot `slot`, picked with probability choice_pdf.
   auto sample = [&](int i, int slot, double choice_pdf) {
     const uint32_t dims = SampleDims::light(bounce, slot);
-    auto cand = light_candidate(scene, ps, i, p, n, on_surface, f,
-                                sampler.get2d(dims + SampleDims::kLightPoint));
+    const std::array<double, 2> u = sampler.get2d(dims + SampleDims::kLightPoint);
+    if (manifold) {
+      const Light& light = scene.lights[size_t(i)];
+      const auto ls = sample_light(light, at.p, u[0], u[1]);
+      if (!ls) return;
+      const auto target = chain_target(light, at.p, *ls);
+      const auto shape = target ? chain_shape(scene, at, *target) : std::nullopt;
+      if (shape) {
+        // The same path sampled by f would take `vertices` more bounces (see the partition).
+        if (depth + shape->vertices >= scene.settings.max_depth) return;
+        sampler.first_from(dims + SampleDims::kShadow);
+        Rng& rng = sampler.rng();
+        const ChainSeed seed = seed_chain(scene, at, *target, *shape);
+        const double q = walk_probability(scene, ps, at, *shape, seed);
+        if (rng.uniform() < q)
+          L += manifold_term<N>(scene, ps, at, *shape, *target, seed, i, *ls, choice_pdf * q,
+                                policy, f, rng, counters);
+        sampler.done();
+        return;
+      }
+      if (at.inside >= 0) return;
+    }
+    auto cand = light_candidate(scene, ps, i, at.p, at.n, at.on_surface, f, u);
     if (!cand) return;
     LightSample& ls = cand->ls;
     // The light technique's pdf includes the pick; a delta light's weight has no pdf to carry it.
@@ -97,15 +121,15 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Vec
     Spectrum<N> term;
     sampler.first_from(dims + SampleDims::kShadow);
     const bool lit =
-        policy.light_term(scene, ps, {cand->origin, ls.wi}, ls.distance * kShadowShrink, i, inside,
-                          ls, cand->f * cand->Li, f_pdf, sampler.rng(), counters, term);
+        policy.light_term(scene, ps, {cand->origin, ls.wi}, ls.distance * kShadowShrink, i,
+                          at.inside, ls, cand->f * cand->Li, f_pdf, sampler.rng(), counters, term);
     sampler.done();
     if (lit) L += term;
   };
   const int lights = static_cast<int>(scene.lights.size());
   if (scene.settings.light_sampling == RenderSettings::LightSampling::One && lights > 1) {
     const auto [i, choice_pdf] =
-        choose_light(scene, ps, p, sampler.get1d(SampleDims::light(bounce, 1)));
+        choose_light(scene, ps, at.p, sampler.get1d(SampleDims::light(bounce, 1)));
     sample(i, 0, choice_pdf);
   } else {
     for (int i = 0; i < lights; ++i) sample(i, i, 1.0);
@@ -154,6 +178,10 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
   // is weighted by MIS; false at the camera, at specular surfaces and inside solids.
   bool light_sampled = false;
   Vec3 prev_p = ray.o;  // where the current direction was sampled
+  // Manifold next-event estimation (render/manifold_light.h), where the scene has something it
+  // looks through; `chain` is what the path did since its last diffuse or medium vertex.
+  const bool manifold = scene.settings.manifold && scene.dielectric_solids;
+  ChainRecord chain;
 
   for (int depth = 0;; ++depth) {
     const uint32_t bounce = SampleDims::bounce(depth, slots);
@@ -172,12 +200,13 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
       if (depth >= scene.settings.max_depth) break;
       const Vec3 p = ray.at(ev.t);
       const MediumPoint<N>& m = ev.medium;
-      // A solid's boundary is specular: no shadow ray can leave it, so skip NEE inside one (a
-      // light inside it is then found by phase sampling alone, with weight 1).
-      if (inside < 0)
+      const ChainStart at{p, {}, false, inside};
+      // Without manifold sampling no shadow ray leaves a solid, whose boundary is specular: a
+      // light is then found from inside by phase sampling alone, with weight 1.
+      if (inside < 0 || manifold)
         L += policy.throughput() *
              direct_light(
-                 scene, ps, p, {}, false, inside, policy,
+                 scene, ps, at, depth, manifold, policy,
                  [&](const Vec3& wi) { return phase_value(m, dot(ray.d, wi)); },
                  [&](const Vec3& wi) { return phase_pdf(m, dot(ray.d, wi)); }, sampler, bounce,
                  counters);
@@ -185,6 +214,7 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
       policy.scattered(phase.weight, phase.pdf);
       prev_p = p;
       light_sampled = inside < 0;
+      chain = ChainRecord::leaving(at, phase.wi, manifold);
       ray = {p, phase.wi};
       if (!policy.roulette(depth, roulette_u)) break;
       continue;
@@ -199,9 +229,12 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
     }
     if (hit->light >= 0) {
       record.light(scene.lights[hit->light], ray, hit->t);
-      L +=
-          policy.light_hit(light_emission(ps, scene, hit->light), scene.lights[hit->light], prev_p,
-                           ray.d, light_sampled, light_sampling_pdf(scene, ps, hit->light, prev_p));
+      // A path through a smooth boundary that manifold sampling at its last vertex finds counts
+      // there only.
+      if (!manifold_covers(scene, ps, chain, hit->light, ray.at(hit->t), counters))
+        L += policy.light_hit(light_emission(ps, scene, hit->light), scene.lights[hit->light],
+                              prev_p, ray.d, light_sampled,
+                              light_sampling_pdf(scene, ps, hit->light, prev_p));
       break;
     }
     const SceneObject& obj = scene.objects[hit->object];
@@ -218,8 +251,9 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
       const Vec3 ns = dot(ray.d, n) < 0 ? n : -n;  // facing the incoming ray
       const Spectrum<N> albedo = evaluate(obj.surface.albedo, ps.ch);
       const Spectrum<N> f = albedo * kInvPi;
+      const ChainStart at{p, ns, true, inside};
       L += policy.throughput() * direct_light(
-                                     scene, ps, p, ns, true, inside, policy,
+                                     scene, ps, at, depth, manifold, policy,
                                      [&](const Vec3& wi) { return f * dot(wi, ns); },
                                      [&](const Vec3& wi) { return dot(wi, ns) * kInvPi; }, sampler,
                                      bounce, counters);
@@ -228,12 +262,14 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
       policy.scattered(albedo, dot(wi, ns) * kInvPi);  // f cos / pdf = albedo
       prev_p = p;
       light_sampled = true;
+      chain = ChainRecord::leaving(at, wi, manifold);
       ray = {offset_origin(scene, p, ns, wi), wi};
     } else {
       const DielectricSample ds = sample_dielectric(-ray.d, n, obj.surface.ior,
                                                     sampler.get1d(bounce + SampleDims::kChoice));
       if (!ds.reflected) inside = dot(ds.wi, n) < 0 ? hit->object : -1;
       light_sampled = false;
+      chain.specular(hit->object, ds.reflected);
       ray = {offset_origin(scene, p, n, ds.wi), ds.wi};
     }
     if (!policy.roulette(depth, roulette_u)) break;

@@ -63,6 +63,8 @@ struct RenderSettings {
   SpectralSettings spectral;
   Sampler sampler = Sampler::ZSobol;
   LightSampling light_sampling = LightSampling::One;
+  // Manifold next-event estimation through smooth dielectric boundaries (render/manifold.h).
+  bool manifold = true;
   AovSet aovs = {};  // the layers written beside the colour (render/aov.h)
 };
 
@@ -111,7 +113,9 @@ struct Scene {
   SurfaceIndex surfaces;  // what `intersect` and `occluded` search (finish_scene builds it)
   LightTree light_tree;   // for picking one of many lights (finish_scene builds it)
   std::vector<int> lights_at_infinity;  // what a ray that leaves the scene meets (finish_scene)
-  double scale = 1;                     // size of the scene's bounds, for ray offsets
+  bool dielectric_solids =
+      false;         // whether an object has a smooth dielectric boundary (finish_scene)
+  double scale = 1;  // size of the scene's bounds, for ray offsets
   // The exponent of its films (film.h: film_exponent of brightest_emission; finish_scene).
   int film_exponent = 0;
   // What compile_scene left out and why, one line each (an object whose shape is empty): the
@@ -171,6 +175,9 @@ int solid_containing(const Scene& scene, const Vec3& p);
 Vec3 outward_normal(const SceneObject& object, const Vec3& p);
 
 // A point just off the surface on the side that w points to, so the next ray starts clear of it.
+// A shadow ray to a point stops short of it by the factor kShadowShrink, clear of the surface
+// there.
+inline constexpr double kShadowShrink = 1 - 1e-7;
 Vec3 offset_origin(const Scene& scene, const Vec3& p, const Vec3& n, const Vec3& w);
 
 }  // namespace nimbus

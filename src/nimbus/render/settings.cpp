@@ -114,6 +114,11 @@ std::vector<Setting> make_settings() {
           "integrator.light_sampling", "light_sampling", kLightSamplingNames,
           "next-event estimation: one light picked by its fluence, or every light",
           [](auto& s) -> auto& { return s.light_sampling; }),
+      boolean(
+          "integrator.manifold",
+          "manifold next-event estimation: lights reach media and diffuse surfaces through smooth "
+          "dielectric boundaries",
+          [](auto& s) -> auto& { return s.manifold; }),
       choice(
           "integrator.tracking", "tracking", kTrackingModeNames, "free-path sampling in media",
           [](auto& s) -> auto& { return s.tracking.mode; }),

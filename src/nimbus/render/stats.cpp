@@ -46,6 +46,11 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
       {"density_lookups_per_real_collision",
        c.real_collisions ? double(c.tracking.lookups) / double(c.real_collisions) : 0.0},
       {"density_lookups_per_sample", samples > 0 ? double(c.tracking.lookups) / samples : 0.0},
+      {"manifold_walks", c.manifold.walks},
+      {"manifold_successes", c.manifold.found},
+      {"manifold_mean_newton_steps",
+       c.manifold.walks ? double(c.manifold.newton_steps) / double(c.manifold.walks) : 0.0},
+      {"manifold_checks", c.manifold.checks},
   };
   // All octrees together: the field's and those inside solids.
   double build_seconds = 0;

@@ -18,6 +18,7 @@
 // with_tracking_policy.
 
 #include <algorithm>
+#include <span>
 
 #include "nimbus/math/rng.h"
 #include "nimbus/render/counters.h"
@@ -41,6 +42,15 @@ bool russian_roulette(Spectrum<N>& beta, double scale, int depth, U&& u) {
   beta /= q;  // unbiased: survivors carry 1/q
   return true;
 }
+
+// One straight segment of a specular chain's shadow path (render/manifold.h), in the medium of
+// `inside` (a solid, or -1 for the field), aimed at `light` (-1: it ends on a boundary).
+struct ShadowSegment {
+  Ray ray;
+  double t_max;
+  int inside;
+  int light;
+};
 
 template <int N, class Flight>
 class PlainTracking {
@@ -69,6 +79,22 @@ class PlainTracking {
                                         boost_, beta_ * fLi, rng, counters);
     if (T.is_black()) return false;
     out = ls.delta ? fLi * T : fLi * T * (power_heuristic(ls.pdf, f_pdf(ls.wi)) / ls.pdf);
+    return true;
+  }
+
+  // Next-event estimation along a specular chain found by manifold sampling: the transmittance
+  // of its segments, each in its own medium. The chain is the only technique for its paths (the
+  // partition in render/integrator.h), so it carries no MIS weight, as a delta light.
+  bool chain_term(const Scene& scene, const PathSpectra<N>& ps,
+                  std::span<const ShadowSegment> segments, const Spectrum<N>& fLi, Rng& rng,
+                  Counters& counters, Spectrum<N>& out) const {
+    Spectrum<N> T(1.0);
+    for (const ShadowSegment& s : segments) {
+      T *= transmittance(scene, ps, s.ray, s.t_max, s.light, s.inside, events_.channel, boost_,
+                         beta_ * fLi * T, rng, counters);
+      if (T.is_black()) return false;
+    }
+    out = fLi * T;
     return true;
   }
 
@@ -138,6 +164,20 @@ class HeroTracking {
       const Spectrum<N> r_l = r_p * s.r_l * ls.pdf, r_u = r_p * s.r_u * f_pdf(ls.wi);
       out = fLi * s.beta / (r_l + r_u).average();
     }
+    return true;
+  }
+
+  // As PlainTracking::chain_term: hero ratio tracking over every segment into one T_ray, r_u and
+  // r_l, weighted as a delta light's.
+  bool chain_term(const Scene& scene, const PathSpectra<N>& ps,
+                  std::span<const ShadowSegment> segments, const Spectrum<N>& fLi, Rng& rng,
+                  Counters& counters, Spectrum<N>& out) const {
+    MisPath<N> s;
+    for (const ShadowSegment& seg : segments)
+      if (!transmittance_mis(scene, ps, seg.ray, seg.t_max, seg.light, seg.inside, hero_, boost_,
+                             path_.beta * fLi, s, rng, counters))
+        return false;
+    out = fLi * s.beta / (path_.r_u * s.r_l).average();
     return true;
   }
 

@@ -14,6 +14,7 @@
 #include "nimbus/media/build_monitor.h"
 #include "nimbus/media/medium_field.h"
 #include "nimbus/media/octree.h"
+#include "nimbus/render/manifold.h"
 #include "nimbus/scene/load.h"
 #include "nimbus/spectral/wavelengths.h"
 
@@ -271,6 +272,7 @@ void finish_scene(Scene& scene, const BuildMonitor& monitor) {
   scene.surfaces = build_surface_index(scene.objects, scene.lights);
   complete_spectra(scene);
   scene.light_tree = build_light_tree(scene.lights);  // after the spectra: powers read bin_max
+  scene.dielectric_solids = has_dielectric_solid(scene);
   scene.lights_at_infinity.clear();
   for (size_t i = 0; i < scene.lights.size(); ++i)
     if (at_infinity(scene.lights[i])) scene.lights_at_infinity.push_back(int(i));

@@ -1,0 +1,166 @@
+#pragma once
+// Manifold next-event estimation in the path loop (render/integrator.h): light that reaches a
+// medium or diffuse vertex through one smooth dielectric solid's boundary (render/manifold.h),
+// and the partition of path space that keeps it from counting twice with BSDF and phase
+// sampling. The light sample is next-event estimation's own: where its straight shadow ray
+// meets a dielectric solid first (or leaves the solid the vertex is in), the chain through that
+// solid to the same light point replaces the shadow ray, which would be blocked. A path sampled
+// from the vertex that reaches a sphere light through the same refractions counts only where
+// that walk, repeated for the point it hit, would not have found it (manifold_covers): the two
+// estimators share no path, and together miss none that sampling can find.
+
+#include <array>
+#include <cmath>
+#include <optional>
+
+#include "nimbus/math/constants.h"
+#include "nimbus/media/medium_field.h"
+#include "nimbus/render/light.h"
+#include "nimbus/render/light_choice.h"
+#include "nimbus/render/manifold.h"
+#include "nimbus/render/path_spectra.h"
+#include "nimbus/render/scene.h"
+#include "nimbus/render/tracking_policies.h"
+#include "nimbus/spectral/spectrum.h"
+
+namespace nimbus {
+
+// What a path did since it left its last diffuse or medium vertex, for manifold_covers.
+struct ChainRecord {
+  ChainStart start;
+  Vec3 dir0;       // the direction it left in
+  int solid = -1;  // the solid it refracted through, or -1
+  int refractions = 0;
+  bool open = false;  // it met only refractions through one solid since (and the setting is on)
+
+  // A new vertex the path leaves in direction w.
+  static ChainRecord leaving(const ChainStart& start, const Vec3& w, bool manifold) {
+    return {start, w, -1, 0, manifold};
+  }
+  // The path met a smooth dielectric boundary of `object`.
+  void specular(int object, bool reflected) {
+    if (reflected || (solid >= 0 && solid != object) || ++refractions > kMaxChainVertices)
+      open = false;
+    solid = object;
+  }
+};
+
+// The target of a light sample for the walk: the point it sampled (point and sphere lights) or
+// the direction (directional); none for the environment, which BSDF sampling serves.
+inline std::optional<ChainTarget> chain_target(const Light& light, const Vec3& p,
+                                               const LightSample& ls) {
+  switch (light.type) {
+    case Light::Type::Directional:
+      return ChainTarget{{}, ls.wi, true};
+    case Light::Type::Point:
+      return ChainTarget{light.position, {}, false};
+    case Light::Type::Sphere:
+      return ChainTarget{p + ls.wi * ls.distance, {}, false};
+    case Light::Type::Environment:
+      break;
+  }
+  return std::nullopt;
+}
+
+// The probability of making the walk for a light sample (docs/media.md, "Light through smooth
+// boundaries"): exp(−τ), τ the optical depth that the octrees' minorants give the seed's path
+// to the boundary and, for two refractions, its straight chord through the solid: about a
+// bound on the chain's transmittance over every channel. Where a dense medium absorbs the
+// chain's light on the way, walking every time lost at equal time (the bench's marble and skin,
+// the demo); the estimate is divided by it, so the image does not change.
+template <int N>
+double walk_probability(const Scene& scene, const PathSpectra<N>& ps, const ChainStart& start,
+                        const ChainShape& shape, const ChainSeed& seed) {
+  double tau = 0;
+  const auto add = [&](const MajorantSegment<N>& seg) {
+    tau += seg.mu_c.min() * (seg.t1 - seg.t0);
+    return true;
+  };
+  const Ray ray{start.p, seed.w};
+  walk_majorant_segments(scene, ps.ch, ray, 0, seed.t_first, start.inside, add);
+  if (seed.t_through > 0)
+    walk_majorant_segments(scene, ps.ch, ray, seed.t_first, seed.t_first + seed.t_through,
+                           shape.solid, add);
+  return std::exp(-tau);
+}
+
+// The light through one specular chain from `start` to light i's sample ls (picked with
+// probability choice_pdf) times the scattering function f at the chain's first direction and
+// the policy's transmittance of its segments. Uses the path's stream for the transmittance.
+template <int N, class Policy, class F>
+Spectrum<N> manifold_term(const Scene& scene, const PathSpectra<N>& ps, const ChainStart& start,
+                          const ChainShape& shape, const ChainTarget& target, const ChainSeed& seed,
+                          int i, const LightSample& ls, double choice_pdf, const Policy& policy,
+                          F&& f, Rng& rng, Counters& counters) {
+  const auto chain = solve_chain(scene, start, target, shape, seed, counters.manifold);
+  if (!chain) return Spectrum<N>(0.0);
+  const Spectrum<N> fv = f(chain->dir0);
+  if (fv.is_black()) return Spectrum<N>(0.0);
+  // The light's emission times the generalized geometry term, per the target's pdf.
+  const Light& light = scene.lights[size_t(i)];
+  double g = chain->jacobian;  // directional: E |dω₀/dω|; point: I |dω₀/dA⊥|
+  if (light.type == Light::Type::Sphere) {
+    // The point was sampled in the cone the light subtends from the start: area density
+    // pdf_ω cos / d² there; the chain leaves the light at cos_y.
+    const Vec3 n_y = normalize(target.point - light.center);
+    const double cos_y = dot(n_y, -chain->dir_out), cos_p = dot(n_y, -ls.wi);
+    const double pdf_area = ls.pdf * cos_p / (ls.distance * ls.distance);
+    if (!(cos_y > 0) || !(pdf_area > 0)) return Spectrum<N>(0.0);
+    g *= cos_y / pdf_area;
+  }
+  const Spectrum<N> fLi =
+      fv * light_emission(ps, scene, i) * (g * chain->transmission / choice_pdf);
+  // The straight segments: start to the boundary, across the solid, out to the light.
+  std::array<ShadowSegment, kMaxChainVertices + 1> segments;
+  const int k = chain->vertices;
+  Vec3 o = start.on_surface ? offset_origin(scene, start.p, start.n, chain->dir0) : start.p;
+  Vec3 d = chain->dir0;
+  int inside = start.inside;
+  for (int v = 0; v < k; ++v) {
+    segments[size_t(v)] = {{o, d}, length(chain->x[v] - o) * kShadowShrink, inside, -1};
+    d = v + 1 < k ? normalize(chain->x[v + 1] - chain->x[v]) : chain->dir_out;
+    o = offset_origin(scene, chain->x[v], chain->n[v], d);
+    inside = v + 1 < k ? shape.solid : -1;
+  }
+  const double t_last = target.at_infinity ? kInf : length(target.point - o) * kShadowShrink;
+  segments[size_t(k)] = {{o, d}, t_last, -1, i};
+  Spectrum<N> out;
+  if (!policy.chain_term(scene, ps, std::span<const ShadowSegment>(segments.data(), size_t(k + 1)),
+                         fLi, rng, counters, out))
+    return Spectrum<N>(0.0);
+  return out;
+}
+
+// Whether manifold next-event estimation at the record's start covers the sampled path that
+// reached sphere light i at y: it picks the light there, samples y, and its walk for y goes
+// through the same refractions to the same first direction. Such a path is then counted by the
+// walk alone.
+template <int N>
+bool manifold_covers(const Scene& scene, const PathSpectra<N>& ps, const ChainRecord& chain, int i,
+                     const Vec3& y, Counters& counters) {
+  if (!chain.open) return false;
+  const int vertices = chain.start.inside >= 0 ? 1 : 2;
+  if (chain.refractions != vertices) return false;
+  const Light& light = scene.lights[size_t(i)];
+  if (light.type != Light::Type::Sphere) return false;
+  const Vec3 p = chain.start.p;
+  if (scene.settings.light_sampling == RenderSettings::LightSampling::One &&
+      !(light_choice_pdf(scene, ps, i, p) > 0))
+    return false;
+  // Next-event estimation samples the point the straight ray from p meets first, in the cone.
+  const double dist = length(y - p);
+  const Vec3 dir = (y - p) / dist;
+  if (!(light_pdf(light, p, dir) > 0)) return false;
+  const auto t = intersect_light(light, {p, dir}, 0, kInf);
+  if (!t || std::abs(*t - dist) > 1e-6 * dist) return false;
+  const ChainTarget target{y, {}, false};
+  const auto shape = chain_shape(scene, chain.start, target);
+  if (!shape || shape->solid != chain.solid || shape->vertices != vertices) return false;
+  ++counters.manifold.checks;
+  ManifoldCounters not_counted;  // a check is not a walk of next-event estimation
+  const auto found = solve_chain(scene, chain.start, target, *shape,
+                                 seed_chain(scene, chain.start, target, *shape), not_counted);
+  return found && same_direction(found->dir0, chain.dir0);
+}
+
+}  // namespace nimbus
