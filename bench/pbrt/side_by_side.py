@@ -16,6 +16,12 @@ in OUT/refs, keyed by the scene file's contents, the overrides and REF_SPP: dele
 after changing a renderer. Two references of the same scene (nimbus spectral mode and pbrt-v4)
 are compared to show that the scenes match: image means, and block means against the
 references' own noise.
+
+--manifold-off (off by default) adds, to every scene run, nimbus with manifold next-event
+estimation turned off (the render setting integrator.manifold=false, issue 41), spectral MIS in
+rgb and in spectral 4 mode, measured against the same reference as manifold sampling on (both
+estimate the same image, so a bias between them would only add to its MSE). A nimbus without
+that setting rejects the key, and the run stops at its first render.
 """
 
 import argparse
@@ -55,6 +61,8 @@ COMMON = ['integrator.sampler="zsobol"']
 # CIE integrals without bias), so it is measured against spectral 4's reference: a bias between
 # them would only add to its MSE.
 DEFAULT_COUNT = ("spectral 8 (default)", ['spectrum.mode="spectral"', "spectrum.wavelengths=8"])
+# --manifold-off: manifold next-event estimation turned off (issue 41; default on).
+MANIFOLD_OFF = ("spectral-mis, manifold off", ["integrator.manifold=false"])
 
 # scene key -> (title, nimbus scene, pbrt scene); paths relative to OUT once staged.
 SCENES = {
@@ -64,6 +72,8 @@ SCENES = {
                    "chromatic_cloud_vdb.json", "chromatic_cloud.pbrt"),
     "marble": ("marble sphere (SSS behind glass, IOR 1.5)", "marble.json", "marble.pbrt"),
     "skin": ("skin ellipsoid (SSS behind glass, IOR 1.3)", "skin.json", "skin.pbrt"),
+    "marble-sun": ("marble sphere under a 1° sun (sphere light)", "marble_sun.json",
+                   "marble_sun.pbrt"),
 }
 
 
@@ -90,7 +100,12 @@ class Ctx:
         try:
             cpu, wall, _ = run_timed(cmd, self.out, os.path.join(self.tmp, tag + ".log"), 2000)
         except RenderFailed as e:
-            sys.exit("command failed (exit %d): %s\n%s" % (e.code, " ".join(e.cmd), e.log_tail))
+            hint = ""
+            if MANIFOLD_OFF[1][0] in r.get("overrides", []):
+                hint = ("\n(--manifold-off needs a nimbus that has the render setting "
+                        "integrator.manifold, issue 41)")
+            sys.exit("command failed (exit %d): %s\n%s%s" % (e.code, " ".join(e.cmd),
+                                                             e.log_tail, hint))
         img = read_exr(self.exr_to_pfm, exr)
         st = json.load(open(stats)) if stats else None
         return img, cpu, wall, st
@@ -121,9 +136,10 @@ class Ctx:
 def stage(ctx):
     """Copies the scenes into OUT and makes the cloud's grid (VDB for nimbus, NanoVDB for pbrt)."""
     out = ctx.out
-    for f in ("chromatic_cloud.json", "marble.json", "skin.json"):
+    for f in ("chromatic_cloud.json", "marble.json", "skin.json", "marble_sun.json"):
         shutil.copyfile(os.path.join(REPO, "scenes", "bench", f), os.path.join(out, f))
-    for f in ("chromatic_cloud_vdb.json", "chromatic_cloud.pbrt", "marble.pbrt", "skin.pbrt"):
+    for f in ("chromatic_cloud_vdb.json", "chromatic_cloud.pbrt", "marble.pbrt", "skin.pbrt",
+              "marble_sun.pbrt"):
         shutil.copyfile(os.path.join(HERE, f), os.path.join(out, f))
     src = os.path.join(out, "chromatic_cloud.json")
     stamp = os.path.join(out, "chromatic_cloud.grid-stamp")
@@ -140,7 +156,7 @@ def stage(ctx):
         open(stamp, "w").write(key)
 
 
-def configs(scene_key):
+def configs(scene_key, manifold_off=False):
     title, nscene, pscene = SCENES[scene_key]
     cs = [{"renderer": "pbrt", "label": "pbrt-v4", "spectrum": "spectral 4",
            "tracking": "spectral MIS (volpath)", "scene": pscene, "overrides": [],
@@ -157,6 +173,12 @@ def configs(scene_key):
                "tracking": "spectral-mis", "scene": nscene,
                "overrides": COMMON + so + TRACKING["spectral-mis"],
                "ref_overrides": COMMON + SPECTRUM["spectral 4"] + TRACKING["spectral-mis"]})
+    if manifold_off:
+        for sp, so in SPECTRUM.items():
+            ref = COMMON + so + TRACKING["spectral-mis"]
+            cs.append({"renderer": "nimbus", "label": "nimbus %s" % sp, "spectrum": sp,
+                       "tracking": MANIFOLD_OFF[0], "scene": nscene,
+                       "overrides": ref + MANIFOLD_OFF[1], "ref_overrides": ref})
     return title, cs
 
 
@@ -193,6 +215,9 @@ def main():
     ap.add_argument("--reps", type=int, default=5)
     ap.add_argument("--voxel-size", dest="voxel_size", type=float, default=1 / 64)
     ap.add_argument("--json", default=None, help="also write the raw results here")
+    ap.add_argument("--manifold-off", dest="manifold_off", action="store_true",
+                    help="also run nimbus with integrator.manifold=false (issue 41; needs a "
+                         "nimbus that has that setting)")
     ap.add_argument("scenes", nargs="*", default=list(SCENES))
     a = ap.parse_args()
     for s in a.scenes:
@@ -203,7 +228,7 @@ def main():
 
     results = {}
     for s in a.scenes:
-        title, cs = configs(s)
+        title, cs = configs(s, a.manifold_off)
         for c in cs:
             c["ref"], c["ref_noise"], c["ref_var"] = ctx.reference(c)
         results[s] = (title, cs)
