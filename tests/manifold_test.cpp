@@ -220,16 +220,20 @@ void expect_blocks_agree(const Film& a, const Film& b, int size, const char* wha
   EXPECT_EQ(compared, size * size / 64 * 3);
 }
 
-RenderResult render_with(const std::string& text, bool manifold) {
+RenderResult render_with(const std::string& text, bool manifold,
+                         std::vector<std::string> overrides = {}) {
   RenderOptions options;
   options.threads = 2;
-  return render(scene_from(text, {fmt::format("integrator.manifold={}", manifold)}), options);
+  overrides.push_back(fmt::format("integrator.manifold={}", manifold));
+  return render(scene_from(text, overrides), options);
 }
 
 // Where both apply (a sphere light of finite size), manifold sampling and BSDF or phase sampling
 // alone estimate the same image; the partition keeps them from counting a path twice.
-void expect_same_image_on_and_off(const std::string& text, int size, const char* what) {
-  const RenderResult on = render_with(text, true), off = render_with(text, false);
+void expect_same_image_on_and_off(const std::string& text, int size, const char* what,
+                                  const std::vector<std::string>& overrides = {}) {
+  const RenderResult on = render_with(text, true, overrides),
+                     off = render_with(text, false, overrides);
   EXPECT_GT(on.counters.manifold.found, 0u) << what;
   EXPECT_GT(on.counters.manifold.checks, 0u) << what;  // the partition decided some light hits
   EXPECT_EQ(off.counters.manifold.walks, 0u) << what;
@@ -242,6 +246,14 @@ const char* kSphereLight =
 TEST(ManifoldRender, MarbleSphereOnAndOffAgree) {
   expect_same_image_on_and_off(glass_scene(kSphere, kMarble, -0.8, kSphereLight, 16, 256), 16,
                                "marble sphere");
+}
+
+// Spectral mode, with plain spectral tracking (one throughput) rather than spectral MIS.
+TEST(ManifoldRender, MarbleSphereOnAndOffAgreeInSpectralMode) {
+  expect_same_image_on_and_off(glass_scene(kSphere, kMarble, -0.8, kSphereLight, 16, 128), 16,
+                               "marble sphere, spectral",
+                               {R"(spectrum.mode="spectral")", "spectrum.wavelengths=4",
+                                R"(integrator.tracking="spectral-history")"});
 }
 
 TEST(ManifoldRender, FreeFormWithFourPerturbationsOnAndOffAgree) {
