@@ -199,6 +199,14 @@ TEST(ManifoldWalk, DegenerateBoundaryFailsCleanly) {
     for (int c = 0; c < 3; ++c) EXPECT_TRUE(std::isfinite(r.film.mean(p)[c])) << p;
 }
 
+// The pixels of the 8 x 8 block whose corner is (bx, by) in a size x size film.
+std::vector<int> block_pixels(int bx, int by, int size) {
+  std::vector<int> pixels;
+  for (int y = by; y < by + 8; ++y)
+    for (int x = bx; x < bx + 8; ++x) pixels.push_back(y * size + x);
+  return pixels;
+}
+
 // Whether two films agree per 8 x 8 block within 4 standard errors of the difference of their
 // means (the blocks' variances from the per-pixel sample variances; independent samples).
 void expect_blocks_agree(const Film& a, const Film& b, int size, const char* what) {
@@ -206,9 +214,7 @@ void expect_blocks_agree(const Film& a, const Film& b, int size, const char* wha
   int compared = 0;
   for (int by = 0; by < size; by += 8)
     for (int bx = 0; bx < size; bx += 8) {
-      std::vector<int> pixels;
-      for (int y = by; y < by + 8; ++y)
-        for (int x = bx; x < bx + 8; ++x) pixels.push_back(y * size + x);
+      const std::vector<int> pixels = block_pixels(bx, by, size);
       const MeanEstimate ma = region_mean(a, pixels), mb = region_mean(b, pixels);
       for (int c = 0; c < 3; ++c) {
         const double se = std::hypot(ma.standard_error[c], mb.standard_error[c]);
@@ -284,9 +290,7 @@ double largest_block_z(const Film& a, const Film& b, int size) {
   double z = 0;
   for (int by = 0; by < size; by += 8)
     for (int bx = 0; bx < size; bx += 8) {
-      std::vector<int> pixels;
-      for (int y = by; y < by + 8; ++y)
-        for (int x = bx; x < bx + 8; ++x) pixels.push_back(y * size + x);
+      const std::vector<int> pixels = block_pixels(bx, by, size);
       const MeanEstimate ma = region_mean(a, pixels), mb = region_mean(b, pixels);
       for (int c = 0; c < 3; ++c)
         z = std::max(z, std::abs(ma.mean[c] - mb.mean[c]) /

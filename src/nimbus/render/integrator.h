@@ -29,8 +29,8 @@
 namespace nimbus {
 namespace integrator_detail {
 
-// One light sample for next-event estimation at p, from the 2D number u, with the scattering
-// function's value there and the shadow ray's origin; none if the light cannot contribute.
+// A light sample for next-event estimation at p with the scattering function's value there and
+// the shadow ray's origin; none if the light cannot contribute.
 template <int N>
 struct LightCandidate {
   LightSample ls;
@@ -41,17 +41,14 @@ struct LightCandidate {
 
 template <int N, class F>
 std::optional<LightCandidate<N>> light_candidate(const Scene& scene, const PathSpectra<N>& ps,
-                                                 int light_index, const Vec3& p, const Vec3& n,
-                                                 bool on_surface, F&& f,
-                                                 const std::array<double, 2>& u) {
-  const Light& light = scene.lights[light_index];
-  const auto ls = sample_light(light, p, u[0], u[1]);
-  if (!ls) return std::nullopt;
-  if (on_surface && dot(ls->wi, n) <= 0) return std::nullopt;
-  const Spectrum<N> fv = f(ls->wi);
+                                                 int light_index, const LightSample& ls,
+                                                 const Vec3& p, const Vec3& n, bool on_surface,
+                                                 F&& f) {
+  if (on_surface && dot(ls.wi, n) <= 0) return std::nullopt;
+  const Spectrum<N> fv = f(ls.wi);
   if (fv.is_black()) return std::nullopt;
-  return LightCandidate<N>{*ls, fv, light_emission(ps, scene, light_index) * ls->falloff,
-                           on_surface ? offset_origin(scene, p, n, ls->wi) : p};
+  return LightCandidate<N>{ls, fv, light_emission(ps, scene, light_index) * ls.falloff,
+                           on_surface ? offset_origin(scene, p, n, ls.wi) : p};
 }
 
 // The light slots of a bounce's sampler dimensions (SampleDims::bounce): one per light, or with
@@ -89,11 +86,11 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Cha
   auto sample = [&](int i, int slot, double choice_pdf) {
     const uint32_t dims = SampleDims::light(bounce, slot);
     const std::array<double, 2> u = sampler.get2d(dims + SampleDims::kLightPoint);
+    const Light& light = scene.lights[size_t(i)];
+    const auto sampled = sample_light(light, at.p, u[0], u[1]);
+    if (!sampled) return;
     if (manifold) {
-      const Light& light = scene.lights[size_t(i)];
-      const auto ls = sample_light(light, at.p, u[0], u[1]);
-      if (!ls) return;
-      const auto target = chain_target(light, at.p, *ls);
+      const auto target = chain_target(light, at.p, *sampled);
       const auto shape = target ? chain_shape(scene, at, *target) : std::nullopt;
       if (shape) {
         // The same path sampled by f would take `vertices` more bounces (see the partition).
@@ -103,14 +100,14 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Cha
         const ChainSeed seed = seed_chain(scene, at, *target, *shape);
         const double q = walk_probability(scene, ps, at, *shape, seed);
         if (rng.uniform() < q)
-          L += manifold_term<N>(scene, ps, at, *shape, *target, seed, i, *ls, choice_pdf * q,
+          L += manifold_term<N>(scene, ps, at, *shape, *target, seed, i, *sampled, choice_pdf * q,
                                 policy, f, rng, counters);
         sampler.done();
         return;
       }
       if (at.inside >= 0) return;
     }
-    auto cand = light_candidate(scene, ps, i, at.p, at.n, at.on_surface, f, u);
+    auto cand = light_candidate(scene, ps, i, *sampled, at.p, at.n, at.on_surface, f);
     if (!cand) return;
     LightSample& ls = cand->ls;
     // The light technique's pdf includes the pick; a delta light's weight has no pdf to carry it.
