@@ -284,6 +284,81 @@ TEST(ManifoldRender, GlassBallCausticOnAFloorOnAndOffAgree) {
                                "glass ball caustic");
 }
 
+// `text` (a glass_scene) with an emissive surface of shape `shape` (JSON) added.
+std::string with_lamp(std::string text, const std::string& shape, const std::string& radiance) {
+  const auto insert_after = [&](const std::string& key, const std::string& what) {
+    const size_t at = text.find(key);
+    EXPECT_NE(at, std::string::npos) << key;
+    text.insert(at + key.size(), what);
+  };
+  insert_after(R"("shapes": {)", R"("lamp": )" + shape + ",");
+  insert_after(
+      R"("objects": [)",
+      R"({"shape": "lamp", "surface": {"type": "emissive", "radiance": )" + radiance + "}},");
+  return text;
+}
+
+// Emissive surfaces are targets too (render/emitter.h): a marble ball lit by an emissive box, and
+// a glass ball's caustic from an emissive ball, on and off.
+TEST(ManifoldRender, EmissiveSurfacesOnAndOffAgree) {
+  const std::string box = R"({"type": "box", "min": [-1.9, 2.1, 1.0], "max": [-1.1, 2.9, 2.0]})";
+  expect_same_image_on_and_off(
+      with_lamp(glass_scene(kSphere, kMarble, -0.8, "[]", 16, 256), box, "[6, 5.5, 5]"), 16,
+      "marble sphere under an emissive box");
+  const char* camera = R"("from": [0.6, 3.2, 0.9], "to": [0.55, -0.8, 0.3], "fov": 30)";
+  expect_same_image_on_and_off(
+      with_lamp(glass_scene(kSphere, "", -0.8, "[]", 16, 256, camera),
+                R"({"type": "sphere", "center": [-0.7, 2.2, -0.4], "radius": 0.5})", "3"),
+      16, "glass ball caustic from an emissive ball");
+}
+
+// The sum over pixels and channels of the estimated variance of each pixel's mean.
+double image_variance(const Film& film, int size) {
+  double v = 0;
+  for (int p = 0; p < size * size; ++p) {
+    const MeanEstimate m = region_mean(film, {p});
+    for (int c = 0; c < 3; ++c) v += m.standard_error[c] * m.standard_error[c];
+  }
+  return v;
+}
+
+// A glass ball mirrors a small sphere light, an emissive ball and the sky (render/mirror_light.h):
+// probing the mirror direction at every sample that meets the glass from outside gives the
+// image that sampling the reflection alone gives, with far less variance where the camera sees
+// the lights reflected.
+TEST(ManifoldRender, MirrorImagesOfLightsOnAndOffAgree) {
+  const int size = 16;
+  const std::string text = fmt::format(
+      R"({{"film": {{"width": {0}, "height": {0}}},
+  "camera": {{"from": [0, 1.5, 4], "to": [0, -0.2, 0], "fov": 40}},
+  "integrator": {{"spp": 256, "seed": 5, "sampler": "independent"}},
+  "lights": [{{"type": "environment", "radiance": [0.2, 0.25, 0.3]}},
+             {{"type": "sphere", "center": [1.5, 3, 4], "radius": 0.3, "radiance": [60, 55, 50]}}],
+  "shapes": {{"ball": {1}, "lamp": {{"type": "sphere", "center": [-1.5, 2, 3.5], "radius": 0.3}},
+             "floor": {{"type": "box", "min": [-4, -1.3, -4], "max": [4, -0.8, 4]}}}},
+  "objects": [
+    {{"shape": "ball", "surface": {{"type": "dielectric", "ior": 1.5}}}},
+    {{"shape": "lamp", "surface": {{"type": "emissive", "radiance": [10, 20, 30]}}}},
+    {{"shape": "floor", "surface": {{"type": "diffuse", "albedo": 0.5}}}}
+  ]}})",
+      size, kSphere);
+  const RenderResult on = render_with(text, true), off = render_with(text, false);
+  EXPECT_GT(on.counters.manifold.mirror_probes, 0u);
+  EXPECT_EQ(off.counters.manifold.mirror_probes, 0u);
+  expect_blocks_agree(on.film, off.film, size, "mirror images");
+  const double v_on = image_variance(on.film, size), v_off = image_variance(off.film, size);
+  // The mirror images' pixels: paths that refract first and reflect inside (or see a light
+  // through the glass) still choose between reflection and refraction, as before.
+  EXPECT_LT(v_on, 0.75 * v_off) << v_on << " vs " << v_off;
+  int sharper = 0;  // pixels whose variance drops tenfold
+  for (int p = 0; p < size * size; ++p) {
+    const double se_on = region_mean(on.film, {p}).standard_error[0],
+                 se_off = region_mean(off.film, {p}).standard_error[0];
+    if (se_off > 0.05 && se_on * se_on * 10 < se_off * se_off) ++sharper;
+  }
+  EXPECT_GE(sharper, 3);
+}
+
 // The largest disagreement of two films over their 8 x 8 blocks and channels, in standard errors
 // of the difference of the block means.
 double largest_block_z(const Film& a, const Film& b, int size) {

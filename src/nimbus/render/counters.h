@@ -9,16 +9,18 @@ namespace nimbus {
 
 // Manifold next-event estimation (render/manifold.h).
 struct ManifoldCounters {
-  uint64_t walks = 0;         // chains sought by next-event estimation
-  uint64_t found = 0;         // of which converged to a valid chain
-  uint64_t newton_steps = 0;  // Newton iterations over all walks
-  uint64_t checks = 0;        // walks repeated to decide whether a sampled path is the walk's
+  uint64_t walks = 0;          // chains sought by next-event estimation
+  uint64_t found = 0;          // of which converged to a valid chain
+  uint64_t newton_steps = 0;   // Newton iterations over all walks
+  uint64_t checks = 0;         // walks repeated to decide whether a sampled path is the walk's
+  uint64_t mirror_probes = 0;  // rays cast in a smooth boundary's mirror direction (mirror_light.h)
 
   ManifoldCounters& operator+=(const ManifoldCounters& o) {
     walks += o.walks;
     found += o.found;
     newton_steps += o.newton_steps;
     checks += o.checks;
+    mirror_probes += o.mirror_probes;
     return *this;
   }
 };

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <utility>
 
 #include "nimbus/math/constants.h"
 #include "nimbus/math/ray.h"
@@ -18,6 +19,7 @@
 #include "nimbus/render/first_vertex.h"
 #include "nimbus/render/light_choice.h"
 #include "nimbus/render/manifold_light.h"
+#include "nimbus/render/mirror_light.h"
 #include "nimbus/render/path_sampler.h"
 #include "nimbus/render/path_spectra.h"
 #include "nimbus/render/sampling.h"
@@ -52,11 +54,13 @@ std::optional<LightCandidate<N>> light_candidate(const Scene& scene, const PathS
 }
 
 // The light slots of a bounce's sampler dimensions (SampleDims::bounce): one per light, or with
-// one light per vertex, the chosen light's and a slot whose first number picks it.
+// one light per vertex, the chosen light's and a slot whose first number picks it; then one for
+// the walk to an emissive surface where manifold sampling makes it.
 inline int light_slots(const Scene& scene) {
   const int lights = static_cast<int>(scene.lights.size());
-  return scene.settings.light_sampling == RenderSettings::LightSampling::One ? std::min(lights, 2)
-                                                                             : lights;
+  return (scene.settings.light_sampling == RenderSettings::LightSampling::One ? std::min(lights, 2)
+                                                                              : lights) +
+         (walks_to_emitters(scene) ? 1 : 0);
 }
 
 // The probability with which next-event estimation at p samples light i: 1 when every light is
@@ -75,8 +79,10 @@ double light_sampling_pdf(const Scene& scene, const PathSpectra<N>& ps, int i, c
 // A light's numbers come from its slot in the block of `bounce` (SampleDims::light; the picked
 // light takes slot 0, the pick slot 1). With `manifold`, a sample whose straight shadow ray
 // leaves the solid the vertex is in, or meets a dielectric solid first, is joined to the light
-// through that solid's boundary instead (render/manifold_light.h); without it, a vertex inside a
-// solid has no next-event estimation (its boundary is specular), and the caller skips it.
+// through that solid's boundary instead (render/manifold_light.h), and a point on one emissive
+// surface is joined the same way, from the slot after the lights' (render/emitter.h); without
+// it, a vertex inside a solid has no next-event estimation (its boundary is specular), and the
+// caller skips it.
 template <int N, class Policy, class F, class Pdf>
 Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const ChainStart& at,
                          int depth, bool manifold, const Policy& policy, F&& f, Pdf&& f_pdf,
@@ -99,9 +105,12 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Cha
         Rng& rng = sampler.rng();
         const ChainSeed seed = seed_chain(scene, at, *target, *shape);
         const double q = walk_probability(scene, ps, at, *shape, seed);
+        const auto emitted = [&](const SpecularChain& c) {
+          return light_chain_emission(scene, ps, i, *target, *sampled, c);
+        };
         if (rng.uniform() < q)
-          L += manifold_term<N>(scene, ps, at, *shape, *target, seed, i, *sampled, choice_pdf * q,
-                                policy, f, rng, counters);
+          L += manifold_term<N>(scene, ps, at, *shape, *target, seed, {i, -1}, emitted,
+                                choice_pdf * q, policy, f, rng, counters);
         sampler.done();
         return;
       }
@@ -130,6 +139,31 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Cha
     sample(i, 0, choice_pdf);
   } else {
     for (int i = 0; i < lights; ++i) sample(i, i, 1.0);
+  }
+  if (manifold && walks_to_emitters(scene)) {
+    // One emissive surface, picked uniformly, through the slot after the lights'.
+    const uint32_t dims = SampleDims::light(bounce, light_slots(scene) - 1);
+    const std::array<double, 2> u = sampler.get2d(dims + SampleDims::kLightPoint);
+    sampler.first_from(dims + SampleDims::kShadow);
+    Rng& rng = sampler.rng();
+    const int emitters = static_cast<int>(scene.emitters.size());
+    const int object =
+        scene.emitters[size_t(std::min(emitters - 1, static_cast<int>(rng.uniform() * emitters)))];
+    const auto e = sample_emitter_point(scene, object, u[0], u[1], rng.uniform());
+    const ChainTarget target{e ? e->y : Vec3{}, {}, false};
+    const auto shape = e ? chain_shape(scene, at, target) : std::nullopt;
+    // A straight ray to the point is BSDF and phase sampling's alone.
+    if (shape && depth + shape->vertices < scene.settings.max_depth) {
+      const ChainSeed seed = seed_chain(scene, at, target, *shape);
+      const double q = walk_probability(scene, ps, at, *shape, seed);
+      const auto emitted = [&](const SpecularChain& c) {
+        return surface_chain_emission(scene, ps, object, *e, c);
+      };
+      if (rng.uniform() < q)
+        L += manifold_term<N>(scene, ps, at, *shape, target, seed, {-1, object}, emitted,
+                              q / emitters, policy, f, rng, counters);
+    }
+    sampler.done();
   }
   return L;
 }
@@ -179,9 +213,13 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
   // looks through; `chain` is what the path did since its last diffuse or medium vertex.
   const bool manifold = scene.settings.manifold && scene.dielectric_solids;
   ChainRecord chain;
+  // The last vertex probed its mirror direction and the path took it: what that ray meets emits
+  // nothing more (render/mirror_light.h).
+  bool mirror_probed = false;
 
   for (int depth = 0;; ++depth) {
     const uint32_t bounce = SampleDims::bounce(depth, slots);
+    const bool emission_counted = std::exchange(mirror_probed, false);
     // Roulette's number is drawn only when roulette plays (the independent sampler's order).
     const auto roulette_u = [&] { return sampler.get1d(bounce + SampleDims::kRoulette); };
     ++counters.surface_rays;
@@ -219,16 +257,18 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
 
     if (!hit) {
       record.escape();
-      for (const int i : scene.lights_at_infinity)
-        L += policy.light_hit(light_emission(ps, scene, i), scene.lights[i], prev_p, ray.d,
-                              light_sampled, light_sampling_pdf(scene, ps, i, prev_p));
+      if (!emission_counted)
+        for (const int i : scene.lights_at_infinity)
+          L += policy.light_hit(light_emission(ps, scene, i), scene.lights[i], prev_p, ray.d,
+                                light_sampled, light_sampling_pdf(scene, ps, i, prev_p));
       break;
     }
     if (hit->light >= 0) {
       record.light(scene.lights[hit->light], ray, hit->t);
       // A path through a smooth boundary that manifold sampling at its last vertex finds counts
       // there only.
-      if (!manifold_covers(scene, ps, chain, hit->light, ray.at(hit->t), counters))
+      if (!emission_counted &&
+          !manifold_covers(scene, ps, chain, hit->light, ray.at(hit->t), counters))
         L += policy.light_hit(light_emission(ps, scene, hit->light), scene.lights[hit->light],
                               prev_p, ray.d, light_sampled,
                               light_sampling_pdf(scene, ps, hit->light, prev_p));
@@ -239,7 +279,10 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
     const Vec3 n = outward_normal(obj, p);
     record.surface(obj.surface, ray, hit->t, n);
     if (obj.surface.type == Surface::Type::Emissive) {
-      if (dot(ray.d, n) < 0) L += policy.emission(evaluate(obj.surface.radiance, ps.ch));
+      // As for a sphere light: what the walk to emissive surfaces finds counts there only.
+      if (!emission_counted && dot(ray.d, n) < 0 &&
+          !manifold_covers_surface(scene, chain, hit->object, p, n, counters))
+        L += policy.emission(evaluate(obj.surface.radiance, ps.ch));
       break;
     }
     if (depth >= scene.settings.max_depth) break;
@@ -264,6 +307,11 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
     } else {
       const DielectricSample ds = sample_dielectric(-ray.d, n, obj.surface.ior,
                                                     sampler.get1d(bounce + SampleDims::kChoice));
+      if (manifold && probes_mirror(ds, ray.d, n)) {
+        L += policy.throughput() *
+             mirror_light(scene, ps, p, n, ray.d, ds.F, inside, policy, rng, counters);
+        mirror_probed = ds.reflected;
+      }
       if (!ds.reflected) inside = dot(ds.wi, n) < 0 ? hit->object : -1;
       light_sampled = false;
       chain.specular(hit->object, ds.reflected);

@@ -4,9 +4,12 @@
 // and the partition of path space that keeps it from counting twice with BSDF and phase
 // sampling. The light sample is next-event estimation's own: where its straight shadow ray
 // meets a dielectric solid first (or leaves the solid the vertex is in), the chain through that
-// solid to the same light point replaces the shadow ray, which would be blocked. A path sampled
-// from the vertex that reaches a sphere light through the same refractions counts only where
-// that walk, repeated for the point it hit, would not have found it (manifold_covers): the two
+// solid to the same light point replaces the shadow ray, which would be blocked. Emissive
+// surfaces, which next-event estimation does not sample, have a walk of their own at each vertex
+// to a point sampled on one of them (render/emitter.h), used only where the straight ray meets a
+// dielectric solid first. A path sampled from the vertex that reaches a sphere light or an
+// emissive surface through the same refractions counts only where that walk, repeated for the
+// point it hit, would not have found it (manifold_covers, manifold_covers_surface): the two
 // estimators share no path, and together miss none that sampling can find.
 
 #include <array>
@@ -15,6 +18,7 @@
 
 #include "nimbus/math/constants.h"
 #include "nimbus/media/medium_field.h"
+#include "nimbus/render/emitter.h"
 #include "nimbus/render/light.h"
 #include "nimbus/render/light_choice.h"
 #include "nimbus/render/manifold.h"
@@ -84,32 +88,29 @@ double walk_probability(const Scene& scene, const PathSpectra<N>& ps, const Chai
   return std::exp(-tau);
 }
 
-// The light through one specular chain from `start` to light i's sample ls (picked with
-// probability choice_pdf) times the scattering function f at the chain's first direction and
-// the policy's transmittance of its segments. Uses the path's stream for the transmittance.
-template <int N, class Policy, class F>
+// What a chain ends on: a light (point, sphere, directional), or an emissive surface.
+struct ChainEnd {
+  int light = -1;
+  int object = -1;
+};
+
+// The light through one specular chain from `start` to `target` times the scattering function f
+// at the chain's first direction and the policy's transmittance of its segments, divided by
+// choice_pdf. `emitted(chain)` is the radiance the light sends back along the chain's last
+// direction per the target's density (what turns the walk's geometry term into the vertex's
+// measure). Uses the path's stream for the transmittance.
+template <int N, class Policy, class F, class Emitted>
 Spectrum<N> manifold_term(const Scene& scene, const PathSpectra<N>& ps, const ChainStart& start,
                           const ChainShape& shape, const ChainTarget& target, const ChainSeed& seed,
-                          int i, const LightSample& ls, double choice_pdf, const Policy& policy,
-                          F&& f, Rng& rng, Counters& counters) {
+                          const ChainEnd& end, Emitted&& emitted, double choice_pdf,
+                          const Policy& policy, F&& f, Rng& rng, Counters& counters) {
   const auto chain = solve_chain(scene, start, target, shape, seed, counters.manifold);
   if (!chain) return Spectrum<N>(0.0);
   const Spectrum<N> fv = f(chain->dir0);
   if (fv.is_black()) return Spectrum<N>(0.0);
-  // The light's emission times the generalized geometry term, per the target's pdf.
-  const Light& light = scene.lights[size_t(i)];
-  double g = chain->jacobian;  // directional: E |dω₀/dω|; point: I |dω₀/dA⊥|
-  if (light.type == Light::Type::Sphere) {
-    // The point was sampled in the cone the light subtends from the start: area density
-    // pdf_ω cos / d² there; the chain leaves the light at cos_y.
-    const Vec3 n_y = normalize(target.point - light.center);
-    const double cos_y = dot(n_y, -chain->dir_out), cos_p = dot(n_y, -ls.wi);
-    const double pdf_area = ls.pdf * cos_p / (ls.distance * ls.distance);
-    if (!(cos_y > 0) || !(pdf_area > 0)) return Spectrum<N>(0.0);
-    g *= cos_y / pdf_area;
-  }
-  const Spectrum<N> fLi =
-      fv * light_emission(ps, scene, i) * (g * chain->transmission / choice_pdf);
+  const Spectrum<N> Le = emitted(*chain);
+  if (Le.is_black()) return Spectrum<N>(0.0);
+  const Spectrum<N> fLi = fv * Le * (chain->jacobian * chain->transmission / choice_pdf);
   // The straight segments: start to the boundary, across the solid, out to the light.
   std::array<ShadowSegment, kMaxChainVertices + 1> segments;
   const int k = chain->vertices;
@@ -122,14 +123,82 @@ Spectrum<N> manifold_term(const Scene& scene, const PathSpectra<N>& ps, const Ch
     o = offset_origin(scene, chain->x[v], chain->n[v], d);
     inside = v + 1 < k ? shape.solid : -1;
   }
-  const double t_last = target.at_infinity ? kInf : length(target.point - o) * kShadowShrink;
-  segments[size_t(k)] = {{o, d}, t_last, -1, i};
+  double t_last = target.at_infinity ? kInf : length(target.point - o) * kShadowShrink;
+  if (end.object >= 0) {
+    // The walk's last direction is the target's to within its tolerance, so the ray may meet the
+    // surface a little before the target: it must meet it there first.
+    const auto hit = intersect(scene, {o, d}, kInf);
+    if (!hit || hit->object != end.object || std::abs(hit->t - t_last) > 1e-4 * t_last)
+      return Spectrum<N>(0.0);
+    t_last = hit->t * kShadowShrink;
+  }
+  segments[size_t(k)] = {{o, d}, t_last, -1, end.light};
   Spectrum<N> out;
   if (!policy.chain_term(scene, ps, std::span<const ShadowSegment>(segments.data(), size_t(k + 1)),
                          fLi, rng, counters, out))
     return Spectrum<N>(0.0);
   return out;
 }
+
+// What light i sends back along a chain to its sample ls from p (manifold_term's `emitted`):
+// its emission, times for a sphere light cos_y / pdf_A, the point having been sampled in the cone
+// the light subtends from p (area density pdf_ω cos / d² there; the chain leaves it at cos_y).
+// The walk's geometry term is then E |dω₀/dω| for a directional light, I |dω₀/dA⊥| for a point.
+template <int N>
+Spectrum<N> light_chain_emission(const Scene& scene, const PathSpectra<N>& ps, int i,
+                                 const ChainTarget& target, const LightSample& ls,
+                                 const SpecularChain& chain) {
+  const Light& light = scene.lights[size_t(i)];
+  double g = 1;
+  if (light.type == Light::Type::Sphere) {
+    const Vec3 n_y = normalize(target.point - light.center);
+    const double cos_y = dot(n_y, -chain.dir_out), cos_p = dot(n_y, -ls.wi);
+    const double pdf_area = ls.pdf * cos_p / (ls.distance * ls.distance);
+    if (!(cos_y > 0) || !(pdf_area > 0)) return Spectrum<N>(0.0);
+    g = cos_y / pdf_area;
+  }
+  return light_emission(ps, scene, i) * g;
+}
+
+// What an emissive surface sends back along a chain to its point e: its radiance times
+// cos_y / pdf_A (render/emitter.h), where the chain meets its outer side.
+template <int N>
+Spectrum<N> surface_chain_emission(const Scene& scene, const PathSpectra<N>& ps, int object,
+                                   const EmitterPoint& e, const SpecularChain& chain) {
+  const double cos_y = dot(e.n, -chain.dir_out);
+  if (!(cos_y > 0)) return Spectrum<N>(0.0);
+  return evaluate(scene.objects[size_t(object)].surface.radiance, ps.ch) * (cos_y / e.pdf_area);
+}
+
+// Whether manifold sampling targets the scene's emissive surfaces: the walk to them is a
+// strategy of its own at each vertex, with its own slot of sampler dimensions.
+inline bool walks_to_emitters(const Scene& scene) {
+  return scene.settings.manifold && scene.dielectric_solids && !scene.emitters.empty();
+}
+
+namespace manifold_detail {
+
+// Whether the walk from the record's start to y goes through the same refractions to the same
+// first direction as the sampled path did.
+inline bool walk_finds(const Scene& scene, const ChainRecord& chain, const Vec3& y,
+                       Counters& counters) {
+  const int vertices = chain.start.inside >= 0 ? 1 : 2;
+  const ChainTarget target{y, {}, false};
+  const auto shape = chain_shape(scene, chain.start, target);
+  if (!shape || shape->solid != chain.solid || shape->vertices != vertices) return false;
+  ++counters.manifold.checks;
+  ManifoldCounters not_counted;  // a check is not a walk of next-event estimation
+  const auto found = solve_chain(scene, chain.start, target, *shape,
+                                 seed_chain(scene, chain.start, target, *shape), not_counted);
+  return found && same_direction(found->dir0, chain.dir0);
+}
+
+// Whether the record is a chain of refractions through one solid that the walk could have made.
+inline bool walkable(const ChainRecord& chain) {
+  return chain.open && chain.refractions == (chain.start.inside >= 0 ? 1 : 2);
+}
+
+}  // namespace manifold_detail
 
 // Whether manifold next-event estimation at the record's start covers the sampled path that
 // reached sphere light i at y: it picks the light there, samples y, and its walk for y goes
@@ -138,9 +207,7 @@ Spectrum<N> manifold_term(const Scene& scene, const PathSpectra<N>& ps, const Ch
 template <int N>
 bool manifold_covers(const Scene& scene, const PathSpectra<N>& ps, const ChainRecord& chain, int i,
                      const Vec3& y, Counters& counters) {
-  if (!chain.open) return false;
-  const int vertices = chain.start.inside >= 0 ? 1 : 2;
-  if (chain.refractions != vertices) return false;
+  if (!manifold_detail::walkable(chain)) return false;
   const Light& light = scene.lights[size_t(i)];
   if (light.type != Light::Type::Sphere) return false;
   const Vec3 p = chain.start.p;
@@ -153,14 +220,16 @@ bool manifold_covers(const Scene& scene, const PathSpectra<N>& ps, const ChainRe
   if (!(light_pdf(light, p, dir) > 0)) return false;
   const auto t = intersect_light(light, {p, dir}, 0, kInf);
   if (!t || std::abs(*t - dist) > 1e-6 * dist) return false;
-  const ChainTarget target{y, {}, false};
-  const auto shape = chain_shape(scene, chain.start, target);
-  if (!shape || shape->solid != chain.solid || shape->vertices != vertices) return false;
-  ++counters.manifold.checks;
-  ManifoldCounters not_counted;  // a check is not a walk of next-event estimation
-  const auto found = solve_chain(scene, chain.start, target, *shape,
-                                 seed_chain(scene, chain.start, target, *shape), not_counted);
-  return found && same_direction(found->dir0, chain.dir0);
+  return manifold_detail::walk_finds(scene, chain, y, counters);
+}
+
+// The same for a sampled path that reached the emissive surface of `object` at y (outward normal
+// n): the walk to emitters samples y with positive density there (render/emitter.h).
+inline bool manifold_covers_surface(const Scene& scene, const ChainRecord& chain, int object,
+                                    const Vec3& y, const Vec3& n, Counters& counters) {
+  if (!walks_to_emitters(scene) || !manifold_detail::walkable(chain)) return false;
+  if (!(emitter_point_pdf(scene, object, y, n) > 0)) return false;
+  return manifold_detail::walk_finds(scene, chain, y, counters);
 }
 
 }  // namespace nimbus

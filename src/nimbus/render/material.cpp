@@ -23,10 +23,10 @@ DielectricSample sample_dielectric(const Vec3& wo, const Vec3& n, double ior, do
     eta = 1 / ior;
   }
   const double F = fresnel_dielectric(cos_i, eta);
-  if (u < F) return {nf * (2 * cos_i) - wo, true};
+  if (u < F) return {nf * (2 * cos_i) - wo, true, F};
   const double sin2_t = (1 - cos_i * cos_i) / (eta * eta);
   const double cos_t = std::sqrt(std::max(0.0, 1 - sin2_t));
-  return {normalize(-wo / eta + nf * (cos_i / eta - cos_t)), false};
+  return {normalize(-wo / eta + nf * (cos_i / eta - cos_t)), false, F};
 }
 
 }  // namespace nimbus

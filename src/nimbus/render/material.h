@@ -21,6 +21,7 @@ double fresnel_dielectric(double cos_i, double eta);
 struct DielectricSample {
   Vec3 wi;
   bool reflected;
+  double F;  // the Fresnel reflectance, the probability of reflection
 };
 // Chooses reflection with probability F, else refraction, so the path weight stays unchanged
 // (the interface is lossless). n is the outward normal of a solid of index `ior` in vacuum.

@@ -114,7 +114,10 @@ struct Scene {
   LightTree light_tree;   // for picking one of many lights (finish_scene builds it)
   std::vector<int> lights_at_infinity;  // what a ray that leaves the scene meets (finish_scene)
   bool dielectric_solids =
-      false;         // whether an object has a smooth dielectric boundary (finish_scene)
+      false;  // whether an object has a smooth dielectric boundary (finish_scene)
+  // The objects with emissive surfaces, which manifold sampling targets (render/emitter.h;
+  // finish_scene).
+  std::vector<int> emitters;
   double scale = 1;  // size of the scene's bounds, for ray offsets
   // The exponent of its films (film.h: film_exponent of brightest_emission; finish_scene).
   int film_exponent = 0;

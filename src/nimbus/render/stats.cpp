@@ -51,6 +51,7 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
       {"manifold_mean_newton_steps",
        c.manifold.walks ? double(c.manifold.newton_steps) / double(c.manifold.walks) : 0.0},
       {"manifold_checks", c.manifold.checks},
+      {"mirror_probes", c.manifold.mirror_probes},
   };
   // All octrees together: the field's and those inside solids.
   double build_seconds = 0;

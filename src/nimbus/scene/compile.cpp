@@ -14,6 +14,7 @@
 #include "nimbus/media/build_monitor.h"
 #include "nimbus/media/medium_field.h"
 #include "nimbus/media/octree.h"
+#include "nimbus/render/emitter.h"
 #include "nimbus/render/manifold.h"
 #include "nimbus/scene/load.h"
 #include "nimbus/spectral/wavelengths.h"
@@ -273,6 +274,7 @@ void finish_scene(Scene& scene, const BuildMonitor& monitor) {
   complete_spectra(scene);
   scene.light_tree = build_light_tree(scene.lights);  // after the spectra: powers read bin_max
   scene.dielectric_solids = has_dielectric_solid(scene);
+  scene.emitters = emissive_objects(scene);
   scene.lights_at_infinity.clear();
   for (size_t i = 0; i < scene.lights.size(); ++i)
     if (at_infinity(scene.lights[i])) scene.lights_at_infinity.push_back(int(i));
