@@ -58,6 +58,17 @@ double emitter_point_pdf(const Scene& scene, int object, const Vec3& y, const Ve
   return std::isfinite(pdf) ? pdf : 0;
 }
 
+double emitter_solid_angle_pdf(const Scene& scene, int object, const Vec3& p, const Vec3& y,
+                               const Vec3& n) {
+  const Vec3 to = y - p;
+  const double d2 = dot(to, to);
+  const double cos_y = -dot(n, to) / std::sqrt(d2);
+  if (!(cos_y > 0) || scene.emitters.empty()) return 0;
+  const double pdf = emitter_point_pdf(scene, object, y, n) * d2 / cos_y /
+                     static_cast<double>(scene.emitters.size());
+  return std::isfinite(pdf) ? pdf : 0;
+}
+
 std::vector<int> emissive_objects(const Scene& scene) {
   std::vector<int> out;
   for (size_t i = 0; i < scene.objects.size(); ++i)

@@ -34,6 +34,12 @@ std::optional<EmitterPoint> sample_emitter_point(const Scene& scene, int object,
 // outward normal n: 0 where it never does.
 double emitter_point_pdf(const Scene& scene, int object, const Vec3& y, const Vec3& n);
 
+// The solid-angle density with which next-event estimation at p picks y on emissive object
+// `object` (outward normal n there): one of the scene's emitters picked uniformly, then
+// sample_emitter_point; 0 where y faces away from p.
+double emitter_solid_angle_pdf(const Scene& scene, int object, const Vec3& p, const Vec3& y,
+                               const Vec3& n);
+
 // The objects with emissive surfaces that the walk targets, in object order (finish_scene).
 std::vector<int> emissive_objects(const Scene& scene);
 

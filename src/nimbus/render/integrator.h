@@ -55,12 +55,12 @@ std::optional<LightCandidate<N>> light_candidate(const Scene& scene, const PathS
 
 // The light slots of a bounce's sampler dimensions (SampleDims::bounce): one per light, or with
 // one light per vertex, the chosen light's and a slot whose first number picks it; then one for
-// the walk to an emissive surface where manifold sampling makes it.
+// a point on an emissive surface, where the scene has one.
 inline int light_slots(const Scene& scene) {
   const int lights = static_cast<int>(scene.lights.size());
   return (scene.settings.light_sampling == RenderSettings::LightSampling::One ? std::min(lights, 2)
                                                                               : lights) +
-         (walks_to_emitters(scene) ? 1 : 0);
+         (scene.emitters.empty() ? 0 : 1);
 }
 
 // The probability with which next-event estimation at p samples light i: 1 when every light is
@@ -140,8 +140,11 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Cha
   } else {
     for (int i = 0; i < lights; ++i) sample(i, i, 1.0);
   }
-  if (manifold && walks_to_emitters(scene)) {
-    // One emissive surface, picked uniformly, through the slot after the lights'.
+  if (!scene.emitters.empty()) {
+    // A point on one emissive surface, picked uniformly, from the slot after the lights'
+    // (render/emitter.h): joined by a walk where the straight ray meets a dielectric solid first,
+    // else by a shadow ray, weighted by MIS with the sampling of f (a vertex inside a solid has
+    // none: its boundary is specular).
     const uint32_t dims = SampleDims::light(bounce, light_slots(scene) - 1);
     const std::array<double, 2> u = sampler.get2d(dims + SampleDims::kLightPoint);
     sampler.first_from(dims + SampleDims::kShadow);
@@ -151,17 +154,38 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Cha
         scene.emitters[size_t(std::min(emitters - 1, static_cast<int>(rng.uniform() * emitters)))];
     const auto e = sample_emitter_point(scene, object, u[0], u[1], rng.uniform());
     const ChainTarget target{e ? e->y : Vec3{}, {}, false};
-    const auto shape = e ? chain_shape(scene, at, target) : std::nullopt;
-    // A straight ray to the point is BSDF and phase sampling's alone.
-    if (shape && depth + shape->vertices < scene.settings.max_depth) {
-      const ChainSeed seed = seed_chain(scene, at, target, *shape);
-      const double q = walk_probability(scene, ps, at, *shape, seed);
-      const auto emitted = [&](const SpecularChain& c) {
-        return surface_chain_emission(scene, ps, object, *e, c);
-      };
-      if (rng.uniform() < q)
-        L += manifold_term<N>(scene, ps, at, *shape, target, seed, {-1, object}, emitted,
-                              q / emitters, policy, f, rng, counters);
+    const auto shape = e && manifold ? chain_shape(scene, at, target) : std::nullopt;
+    const Spectrum<N> Le = evaluate(scene.objects[size_t(object)].surface.radiance, ps.ch);
+    if (shape) {
+      if (depth + shape->vertices < scene.settings.max_depth &&
+          may_arrive_in_front(scene, *shape, *e)) {
+        const ChainSeed seed = seed_chain(scene, at, target, *shape);
+        const double q = walk_probability(scene, ps, at, *shape, seed);
+        const auto emitted = [&](const SpecularChain& c) {
+          return surface_chain_emission(Le, *e, c);
+        };
+        if (rng.uniform() < q)
+          L += manifold_term<N>(scene, ps, at, *shape, target, seed, {-1, object}, emitted,
+                                q / emitters, policy, f, rng, counters);
+      }
+    } else if (e && at.inside < 0) {
+      const Vec3 to = e->y - at.p;
+      const double d = length(to);
+      const Vec3 wi = to / d;
+      const double cos_y = dot(e->n, -wi);
+      if (cos_y > 0 && d > 0 && !(at.on_surface && dot(wi, at.n) <= 0)) {
+        const Spectrum<N> fv = f(wi);
+        LightSample ls{wi, d, 1.0, e->pdf_area * d * d / cos_y / emitters, false};
+        // The shadow ray runs from its own origin to just short of the point: the emitter
+        // blocks it anywhere past that.
+        const Vec3 o = at.on_surface ? offset_origin(scene, at.p, at.n, wi) : at.p;
+        const double t = length(e->y - o);
+        Spectrum<N> term;
+        if (!fv.is_black() && ls.pdf > 0 && std::isfinite(ls.pdf) &&
+            policy.light_term(scene, ps, {o, (e->y - o) / t}, t * kShadowShrink, -1, at.inside, ls,
+                              fv * Le, f_pdf, rng, counters, term))
+          L += term;
+      }
     }
     sampler.done();
   }
@@ -208,6 +232,9 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
   // The last vertex sampled the lights (next-event estimation), so a light the path hits next
   // is weighted by MIS; false at the camera, at specular surfaces and inside solids.
   bool light_sampled = false;
+  // The last vertex sampled emissive surfaces by a shadow ray (it is outside every solid), so a
+  // surface the path hits next is weighted by MIS.
+  bool emitters_sampled = false;
   Vec3 prev_p = ray.o;  // where the current direction was sampled
   // Manifold next-event estimation (render/manifold_light.h), where the scene has something it
   // looks through; `chain` is what the path did since its last diffuse or medium vertex.
@@ -249,6 +276,7 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
       policy.scattered(phase.weight, phase.pdf);
       prev_p = p;
       light_sampled = inside < 0;
+      emitters_sampled = inside < 0;
       chain = ChainRecord::leaving(at, phase.wi, manifold);
       ray = {p, phase.wi};
       if (!policy.roulette(depth, roulette_u)) break;
@@ -282,7 +310,9 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
       // As for a sphere light: what the walk to emissive surfaces finds counts there only.
       if (!emission_counted && dot(ray.d, n) < 0 &&
           !manifold_covers_surface(scene, chain, hit->object, p, n, counters))
-        L += policy.emission(evaluate(obj.surface.radiance, ps.ch));
+        L += policy.emission(
+            evaluate(obj.surface.radiance, ps.ch), emitters_sampled,
+            emitters_sampled ? emitter_solid_angle_pdf(scene, hit->object, prev_p, p, n) : 0);
       break;
     }
     if (depth >= scene.settings.max_depth) break;
@@ -302,6 +332,7 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
       policy.scattered(albedo, dot(wi, ns) * kInvPi);  // f cos / pdf = albedo
       prev_p = p;
       light_sampled = true;
+      emitters_sampled = inside < 0;
       chain = ChainRecord::leaving(at, wi, manifold);
       ray = {offset_origin(scene, p, ns, wi), wi};
     } else {
@@ -314,6 +345,7 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
       }
       if (!ds.reflected) inside = dot(ds.wi, n) < 0 ? hit->object : -1;
       light_sampled = false;
+      emitters_sampled = false;
       chain.specular(hit->object, ds.reflected);
       ray = {offset_origin(scene, p, n, ds.wi), ds.wi};
     }

@@ -160,14 +160,29 @@ Spectrum<N> light_chain_emission(const Scene& scene, const PathSpectra<N>& ps, i
   return light_emission(ps, scene, i) * g;
 }
 
-// What an emissive surface sends back along a chain to its point e: its radiance times
+// What an emissive surface of radiance Le sends back along a chain to its point e: Le times
 // cos_y / pdf_A (render/emitter.h), where the chain meets its outer side.
 template <int N>
-Spectrum<N> surface_chain_emission(const Scene& scene, const PathSpectra<N>& ps, int object,
-                                   const EmitterPoint& e, const SpecularChain& chain) {
+Spectrum<N> surface_chain_emission(const Spectrum<N>& Le, const EmitterPoint& e,
+                                   const SpecularChain& chain) {
   const double cos_y = dot(e.n, -chain.dir_out);
   if (!(cos_y > 0)) return Spectrum<N>(0.0);
-  return evaluate(scene.objects[size_t(object)].surface.radiance, ps.ch) * (cos_y / e.pdf_area);
+  return Le * (cos_y / e.pdf_area);
+}
+
+// Whether a chain through shape's solid can reach the emitter's point e on its outer side: its
+// last segment leaves the solid's boundary, so some corner of the solid's bounds must lie in
+// front of the tangent plane at e. Half of the points sampled on a compact emitter fail this,
+// and a walk to them, which could only find a chain that arrives from behind, costs as much as
+// any other.
+inline bool may_arrive_in_front(const Scene& scene, const ChainShape& shape,
+                                const EmitterPoint& e) {
+  const Box& b = scene.objects[size_t(shape.solid)].bounds;
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 corner{c & 1 ? b.hi.x : b.lo.x, c & 2 ? b.hi.y : b.lo.y, c & 4 ? b.hi.z : b.lo.z};
+    if (dot(e.n, corner - e.y) > 0) return true;
+  }
+  return false;
 }
 
 // Whether manifold sampling targets the scene's emissive surfaces: the walk to them is a

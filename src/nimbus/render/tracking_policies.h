@@ -107,8 +107,11 @@ class PlainTracking {
                           : 1.0);
   }
 
-  // Radiance of an emissive surface the path hits (never light-sampled).
-  Spectrum<N> emission(const Spectrum<N>& Le) const { return beta_ * Le; }
+  // Radiance Le of an emissive surface the path hits; `light_sampled`: the vertex before sampled
+  // a point on it too, with solid-angle density light_pdf (render/emitter.h).
+  Spectrum<N> emission(const Spectrum<N>& Le, bool light_sampled, double light_pdf) const {
+    return beta_ * Le * (light_sampled ? power_heuristic(prev_pdf_, light_pdf) : 1.0);
+  }
 
   // A scattering vertex: the throughput times weight (f cos / pdf), the direction drawn with pdf.
   void scattered(const Spectrum<N>& weight, double pdf) {
@@ -188,8 +191,9 @@ class HeroTracking {
     return path_.beta * Le / (path_.r_u + r_l).average();
   }
 
-  Spectrum<N> emission(const Spectrum<N>& Le) const {
-    return path_.beta * Le / path_.r_u.average();
+  Spectrum<N> emission(const Spectrum<N>& Le, bool light_sampled, double light_pdf) const {
+    if (!light_sampled) return path_.beta * Le / path_.r_u.average();
+    return path_.beta * Le / (path_.r_u + path_.r_l * light_pdf).average();
   }
 
   void scattered(const Spectrum<N>& weight, double pdf) {
