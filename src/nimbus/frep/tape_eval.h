@@ -27,6 +27,9 @@ template <class T, class Leaf>
 T run_tape(const Tape& tape, const Leaf& leaf) {
   using std::max;
   using std::min;
+  // One quadric (a sphere, a box's slab is three): its value is the result, without the register
+  // file, whose set-up cost more than the quadric on the walk's gradients (render/manifold.cpp).
+  if (tape.code.size() == 1 && tape.code[0].op == Op::Quadric) return leaf(tape.code[0].quadric);
   std::array<T, kMaxRegisters> r;
   for (const Instr& in : tape.code) {
     switch (in.op) {

@@ -48,10 +48,10 @@ std::optional<double> hit_near(const Tape& tape, const Ray& ray, const Vec3& nea
   const double t0 = dot(near - ray.o, ray.d);
   double t = t0;
   for (int i = 0; i < 8; ++i) {
-    const Vec3 p = ray.at(t);
-    const double slope = dot(gradient(tape, p), ray.d);
+    const DualGrad f = value_gradient(tape, ray.at(t));
+    const double slope = dot(f.grad, ray.d);
     if (!(slope != 0) || !std::isfinite(slope)) return std::nullopt;
-    const double step = evaluate(tape, p) / slope;
+    const double step = f.value / slope;
     t -= step;
     if (!(std::abs(t - t0) <= reach * (1 + std::abs(t0))) || !(t > 0)) return std::nullopt;
     if (std::abs(step) <= 1e-15 * (1 + std::abs(t))) return t;
