@@ -350,6 +350,28 @@ TEST(ManifoldRender, MirrorImagesOfLightsOnAndOffAgree) {
   EXPECT_LT(v_on, v_off) << v_on << " vs " << v_off;
 }
 
+// A sphere light and a diffuse slab inside a fog-filled glass ball: next-event estimation from
+// inside reaches the light by a straight shadow ray, which the walk leaves alone, and phase and
+// BSDF sampling's hits of it carry the matching MIS weight.
+TEST(ManifoldRender, LightInsideASolidOnAndOffAgree) {
+  const int size = 16;
+  const std::string text = fmt::format(
+      R"({{"film": {{"width": {0}, "height": {0}}},
+  "camera": {{"from": [0, 2.5, 2.5], "to": [0, -0.3, 0], "fov": 24}},
+  "integrator": {{"spp": 256, "seed": 3, "sampler": "independent"}},
+  "lights": [{{"type": "sphere", "center": [0.3, 0.5, 0.2], "radius": 0.15, "radiance": 20}}],
+  "shapes": {{"ball": {{"type": "sphere", "radius": 1.2}},
+             "slab": {{"type": "box", "min": [-0.8, -0.5, -0.8], "max": [0.8, -0.3, 0.8]}}}},
+  "media": {{"fog": {1}}},
+  "objects": [
+    {{"shape": "ball", "medium": "fog", "surface": {{"type": "dielectric", "ior": 1.3}}}},
+    {{"shape": "slab", "surface": {{"type": "diffuse", "albedo": 0.7}}}}
+  ]}})",
+      size, R"({"sigma_a": 0.05, "sigma_s": 0.5, "density": {"type": "constant"}})");
+  expect_blocks_agree(render_with(text, true).film, render_with(text, false).film, size,
+                      "light inside a solid");
+}
+
 // The largest disagreement of two films over their 8 x 8 blocks and channels, in standard errors
 // of the difference of the block means.
 double largest_block_z(const Film& a, const Film& b, int size) {

@@ -114,7 +114,6 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Cha
         sampler.done();
         return;
       }
-      if (at.inside >= 0) return;
     }
     auto cand = light_candidate(scene, ps, i, *sampled, at.p, at.n, at.on_surface, f);
     if (!cand) return;
@@ -264,7 +263,8 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
       const MediumPoint<N>& m = ev.medium;
       const ChainStart at{p, {}, false, inside};
       // Without manifold sampling no shadow ray leaves a solid, whose boundary is specular: a
-      // light is then found from inside by phase sampling alone, with weight 1.
+      // light is then found from inside by phase sampling alone, with weight 1. With it, a light
+      // the straight shadow ray reaches inside the solid is sampled too, and weighted by MIS.
       if (inside < 0 || manifold)
         L += policy.throughput() *
              direct_light(
@@ -275,7 +275,7 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
       const PhaseSample<N> phase = draw_phase(m, ray.d, sampler, bounce);
       policy.scattered(phase.weight, phase.pdf);
       prev_p = p;
-      light_sampled = inside < 0;
+      light_sampled = inside < 0 || manifold;
       emitters_sampled = inside < 0;
       chain = ChainRecord::leaving(at, phase.wi, manifold);
       ray = {p, phase.wi};
