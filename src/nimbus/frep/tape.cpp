@@ -218,13 +218,6 @@ double evaluate(const Tape& tape, const Vec3& p) {
   return run_tape<double>(tape, [&](std::uint32_t i) { return tape.quadrics[i].eval_finite(p); });
 }
 
-DualGrad value_gradient(const Tape& tape, const Vec3& p) {
-  return run_tape<DualGrad>(tape, [&](std::uint32_t i) {
-    const Quadric& q = tape.quadrics[i];
-    return DualGrad{q.eval_finite(p), q.gradient_finite(p)};
-  });
-}
-
 Vec3 gradient(const Tape& tape, const Vec3& p) {
   return value_gradient(tape, p).grad;
 }

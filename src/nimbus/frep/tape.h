@@ -12,7 +12,6 @@
 #include "nimbus/frep/quadric.h"
 #include "nimbus/frep/shape_desc.h"
 #include "nimbus/math/box.h"
-#include "nimbus/math/dual.h"
 #include "nimbus/math/interval.h"
 #include "nimbus/math/vec3.h"
 
@@ -103,9 +102,8 @@ Tape compile(const ShapeDesc& shape, FUse use = FUse::Value);
 // bounds.h) instead of searched: a shape used by many objects is searched once.
 Tape compile_placed(const ShapeDesc& shape, const Mat4& placement, FUse use, const Bounds& local);
 
-double evaluate(const Tape& tape, const Vec3& p);          // F(p), > 0 inside
-Vec3 gradient(const Tape& tape, const Vec3& p);            // ∇F(p), forward mode; points inward
-DualGrad value_gradient(const Tape& tape, const Vec3& p);  // F(p) and ∇F(p) in one pass
-Interval evaluate(const Tape& tape, const Box& box);       // encloses F over the box
+double evaluate(const Tape& tape, const Vec3& p);     // F(p), > 0 inside
+Vec3 gradient(const Tape& tape, const Vec3& p);       // ∇F(p), forward mode; points inward
+Interval evaluate(const Tape& tape, const Box& box);  // encloses F over the box
 
 }  // namespace nimbus

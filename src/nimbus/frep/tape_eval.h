@@ -54,6 +54,14 @@ T run_tape(const Tape& tape, const Leaf& leaf) {
   return r[0];
 }
 
+// F(p) and ∇F(p) in one pass (tape.h's gradient() keeps only the gradient).
+inline DualGrad value_gradient(const Tape& tape, const Vec3& p) {
+  return run_tape<DualGrad>(tape, [&](std::uint32_t i) {
+    const Quadric& q = tape.quadrics[i];
+    return DualGrad{q.eval_finite(p), q.gradient_finite(p)};
+  });
+}
+
 // Encloses a quadric over a finite box by its centred form around the centre c:
 //   F(c + h) = F(c) + ∇F(c)·h + Σ_i A_ii h_i² + A12 h1 h2 + A13 h1 h3 + A23 h2 h3,
 // whose overestimate shrinks quadratically with the box (a plain interval Horner form's only

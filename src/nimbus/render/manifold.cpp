@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "nimbus/frep/tape_eval.h"
 #include "nimbus/math/box.h"
 #include "nimbus/math/constants.h"
 #include "nimbus/render/material.h"
