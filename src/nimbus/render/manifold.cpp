@@ -17,7 +17,7 @@ namespace {
 // double precision, so the difference quotients are good to about 1e-8.
 constexpr int kMaxSteps = 16;
 constexpr int kMaxHalvings = 8;
-constexpr double kMaxStep = 0.3;
+constexpr double kMaxStep = 1.0;
 constexpr double kDiff = 1e-7;
 // How far (relative) a vertex may move from the nearby chain's when it is sought by Newton's
 // method (hit_near): across a difference quotient's step, and across a step of the walk.
