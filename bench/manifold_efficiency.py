@@ -10,13 +10,16 @@ gives the MSE over the pixels whose reference stays below V in every channel: a 
 image in a glass surface, which the camera sees directly and which no light-sampling technique
 samples, is then left out (it dominates every MSE alike).
 
+--compare SETTING compares a boolean setting true against false instead (the walk on in both,
+and the reference made with it true), e.g. integrator.manifold_area_caustics.
+
 Timing (--vs OTHER_NIMBUS): per scene, the two binaries render the same scene with its own
 settings, REPS times each, interleaved, and the script prints the median CPU seconds of each and
 the median of the pairwise ratios (this binary / OTHER).
 
   /usr/bin/python3 bench/manifold_efficiency.py [--nimbus build/nimbus] [--spp 16]
       [--ref-spp 4096] [--reps 4] [--threads 2] [--mask-above V] [--set KEY=VALUE ...]
-      [--vs OTHER_NIMBUS] SCENE...
+      [--compare SETTING] [--vs OTHER_NIMBUS] SCENE...
 
 Exit status: 0 done, 2 bad arguments or a render that failed.
 """
@@ -68,14 +71,16 @@ def render(a, scene, out, spp, seed, sets, nimbus=None):
 
 def efficiency(a, scene):
     text = open(scene, "rb").read()
-    key = hashlib.sha256(text + repr((a.ref_spp, a.set)).encode()).hexdigest()[:16]
+    key = hashlib.sha256(text + repr((a.ref_spp, a.set) + ((a.compare,) if a.compare else ())).encode()).hexdigest()[:16]
     ref_path = os.path.join(a.out, "ref-%s.exr" % key)
     if not os.path.exists(ref_path):
-        render(a, scene, ref_path, a.ref_spp, 977, ["integrator.manifold=true"])
+        render(a, scene, ref_path, a.ref_spp, 977, ["integrator.manifold=true"] +
+               (["%s=true" % a.compare] if a.compare else []))
     ref = read_exr(ref_path)
     mask = ref.max(axis=2) < a.mask_above if a.mask_above else None
-    configs = [("manifold on", ["integrator.manifold=true"]),
-               ("manifold off", ["integrator.manifold=false"])]
+    setting = a.compare or "integrator.manifold"
+    configs = [("%s on" % setting.split(".")[-1], ["%s=true" % setting]),
+               ("%s off" % setting.split(".")[-1], ["%s=false" % setting])]
     res = {label: ([], [], []) for label, _ in configs}
     for rep in range(a.reps):
         for label, sets in configs:
@@ -124,6 +129,9 @@ def main():
     p.add_argument("--mask-above", type=float, default=0)
     p.add_argument("--set", action="append", default=[])
     p.add_argument("--vs", help="time this nimbus binary against another one")
+    p.add_argument("--compare", metavar="SETTING",
+                   help="compare a boolean setting true against false (with the walk on) "
+                        "instead of integrator.manifold on against off; one reference, made true")
     p.add_argument("--out", default=os.path.join(REPO, "build", "manifold-efficiency"))
     a = p.parse_args()
     if a.spp < 1 or a.ref_spp < 1 or a.reps < 1 or a.threads < 1:

@@ -280,8 +280,14 @@ TEST(ManifoldRender, GlassBallCausticOnAFloorOnAndOffAgree) {
   const char* light =
       R"([{"type": "sphere", "center": [-0.7, 2.2, -0.4], "radius": 0.5, "radiance": [3, 3, 3]}])";
   const char* camera = R"("from": [0.6, 3.2, 0.9], "to": [0.55, -0.8, 0.3], "fov": 30)";
-  expect_same_image_on_and_off(glass_scene(kSphere, "", -0.8, light, 16, 256, camera), 16,
-                               "glass ball caustic");
+  const std::string text = glass_scene(kSphere, "", -0.8, light, 16, 256, camera);
+  expect_same_image_on_and_off(text, 16, "glass ball caustic");
+  // Without area caustics the caustic is left to BSDF sampling: no walk, the same image.
+  const RenderResult no_caustics =
+      render_with(text, true, {"integrator.manifold_area_caustics=false"});
+  EXPECT_EQ(no_caustics.counters.manifold.walks, 0u);
+  expect_blocks_agree(no_caustics.film, render_with(text, false).film, 16,
+                      "glass ball caustic, no walks");
 }
 
 // `text` (a glass_scene) with an emissive surface of shape `shape` (JSON) added.

@@ -99,6 +99,8 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Cha
       const auto target = chain_target(light, at.p, *sampled);
       const auto shape = target ? chain_shape(scene, at, *target) : std::nullopt;
       if (shape) {
+        // The straight shadow ray is blocked; a caustic of an area light is BSDF sampling's.
+        if (!sampled->delta && !walks_to_area(scene, shape->vertices)) return;
         // The same path sampled by f would take `vertices` more bounces (see the partition).
         if (depth + shape->vertices >= scene.settings.max_depth) return;
         sampler.first_from(dims + SampleDims::kShadow);
@@ -157,7 +159,7 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Cha
     const Spectrum<N> Le = evaluate(scene.objects[size_t(object)].surface.radiance, ps.ch);
     if (shape) {
       if (depth + shape->vertices < scene.settings.max_depth &&
-          may_arrive_in_front(scene, *shape, *e)) {
+          walks_to_area(scene, shape->vertices) && may_arrive_in_front(scene, *shape, *e)) {
         const ChainSeed seed = seed_chain(scene, at, target, *shape);
         const double q = walk_probability(scene, ps, at, *shape, seed);
         const auto emitted = [&](const SpecularChain& c) {

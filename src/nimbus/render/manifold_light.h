@@ -192,6 +192,15 @@ inline bool may_arrive_in_front(const Scene& scene, const ChainShape& shape,
   return false;
 }
 
+// Whether the walk takes a chain of `vertices` refractions to a light with an area (a sphere
+// light, an emissive surface): through a solid from outside (a caustic) only with
+// integrator.manifold_area_caustics. At equal time such walks won against BSDF sampling on some
+// scenes and lost on others (docs/benchmarks.md); point and directional lights have no other
+// technique, so they always walk.
+inline bool walks_to_area(const Scene& scene, int vertices) {
+  return vertices == 1 || scene.settings.manifold_area_caustics;
+}
+
 // Whether manifold sampling targets the scene's emissive surfaces: the walk to them is a
 // strategy of its own at each vertex, with its own slot of sampler dimensions.
 inline bool walks_to_emitters(const Scene& scene) {
@@ -216,8 +225,9 @@ inline bool walk_finds(const Scene& scene, const ChainRecord& chain, const Vec3&
 }
 
 // Whether the record is a chain of refractions through one solid that the walk could have made.
-inline bool walkable(const ChainRecord& chain) {
-  return chain.open && chain.refractions == (chain.start.inside >= 0 ? 1 : 2);
+inline bool walkable(const Scene& scene, const ChainRecord& chain) {
+  const int vertices = chain.start.inside >= 0 ? 1 : 2;
+  return chain.open && chain.refractions == vertices && walks_to_area(scene, vertices);
 }
 
 }  // namespace manifold_detail
@@ -229,7 +239,7 @@ inline bool walkable(const ChainRecord& chain) {
 template <int N>
 bool manifold_covers(const Scene& scene, const PathSpectra<N>& ps, const ChainRecord& chain, int i,
                      const Vec3& y, Counters& counters) {
-  if (!manifold_detail::walkable(chain)) return false;
+  if (!manifold_detail::walkable(scene, chain)) return false;
   const Light& light = scene.lights[size_t(i)];
   if (light.type != Light::Type::Sphere) return false;
   const Vec3 p = chain.start.p;
@@ -249,7 +259,7 @@ bool manifold_covers(const Scene& scene, const PathSpectra<N>& ps, const ChainRe
 // n): the walk to emitters samples y with positive density there (render/emitter.h).
 inline bool manifold_covers_surface(const Scene& scene, const ChainRecord& chain, int object,
                                     const Vec3& y, const Vec3& n, Counters& counters) {
-  if (!walks_to_emitters(scene) || !manifold_detail::walkable(chain)) return false;
+  if (!walks_to_emitters(scene) || !manifold_detail::walkable(scene, chain)) return false;
   if (!(emitter_point_pdf(scene, object, y, n) > 0)) return false;
   return manifold_detail::walk_finds(scene, chain, y, counters);
 }

@@ -65,6 +65,9 @@ struct RenderSettings {
   LightSampling light_sampling = LightSampling::One;
   // Manifold next-event estimation through smooth dielectric boundaries (render/manifold.h).
   bool manifold = true;
+  // With it, also chains through a solid from outside (caustics) to sphere lights and emissive
+  // surfaces, which BSDF sampling finds too; point and directional lights always have them.
+  bool manifold_area_caustics = true;
   AovSet aovs = {};  // the layers written beside the colour (render/aov.h)
 };
 

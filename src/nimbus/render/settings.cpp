@@ -119,6 +119,12 @@ std::vector<Setting> make_settings() {
           "manifold next-event estimation: lights reach media and diffuse surfaces through smooth "
           "dielectric boundaries",
           [](auto& s) -> auto& { return s.manifold; }),
+      boolean(
+          "integrator.manifold_area_caustics",
+          "manifold next-event estimation also through a solid from outside (caustics) to sphere "
+          "lights and emissive surfaces, which BSDF sampling finds as well; point and directional "
+          "lights always",
+          [](auto& s) -> auto& { return s.manifold_area_caustics; }),
       choice(
           "integrator.tracking", "tracking", kTrackingModeNames, "free-path sampling in media",
           [](auto& s) -> auto& { return s.tracking.mode; }),
