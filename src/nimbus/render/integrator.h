@@ -101,18 +101,21 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Cha
       if (shape) {
         // The straight shadow ray is blocked; a caustic of an area light is BSDF sampling's.
         if (!sampled->delta && !walks_to_area(scene, shape->vertices)) return;
-        // The same path sampled by f would take `vertices` more bounces (see the partition).
+        // The same path sampled by f would take `vertices` more bounces (MIS's weights).
         if (depth + shape->vertices >= scene.settings.max_depth) return;
         sampler.first_from(dims + SampleDims::kShadow);
         Rng& rng = sampler.rng();
         const ChainSeed seed = seed_chain(scene, at, *target, *shape);
-        const double q = walk_probability(scene, ps, at, *shape, seed);
+        const double q = walk_probability(scene, ps, at, *shape, seed) *
+                         (shape->vertices == 2 && !sampled->delta
+                              ? caustic_walk_share(at.p, light.center, light.radius)
+                              : 1.0);
         const auto emitted = [&](const SpecularChain& c) {
           return light_chain_emission(scene, ps, i, *target, *sampled, c);
         };
         if (rng.uniform() < q)
           L += manifold_term<N>(scene, ps, at, *shape, *target, seed, {i, -1}, emitted,
-                                choice_pdf * q, policy, f, rng, counters);
+                                choice_pdf * q, policy, f, f_pdf, rng, counters);
         sampler.done();
         return;
       }
@@ -161,13 +164,17 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Cha
       if (depth + shape->vertices < scene.settings.max_depth &&
           walks_to_area(scene, shape->vertices) && may_arrive_in_front(scene, *shape, *e)) {
         const ChainSeed seed = seed_chain(scene, at, target, *shape);
-        const double q = walk_probability(scene, ps, at, *shape, seed);
+        const Box& b = scene.objects[size_t(object)].bounds;
+        const double q =
+            walk_probability(scene, ps, at, *shape, seed) *
+            (shape->vertices == 2 ? caustic_walk_share(at.p, b.center(), 0.5 * length(b.extent()))
+                                  : 1.0);
         const auto emitted = [&](const SpecularChain& c) {
           return surface_chain_emission(Le, *e, c);
         };
         if (rng.uniform() < q)
           L += manifold_term<N>(scene, ps, at, *shape, target, seed, {-1, object}, emitted,
-                                q / emitters, policy, f, rng, counters);
+                                q / emitters, policy, f, f_pdf, rng, counters);
       }
     } else if (e && at.inside < 0) {
       const Vec3 to = e->y - at.p;
@@ -295,13 +302,16 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
     }
     if (hit->light >= 0) {
       record.light(scene.lights[hit->light], ray, hit->t);
-      // A path through a smooth boundary that manifold sampling at its last vertex finds counts
-      // there only.
-      if (!emission_counted &&
-          !manifold_covers(scene, ps, chain, hit->light, ray.at(hit->t), counters))
-        L += policy.light_hit(light_emission(ps, scene, hit->light), scene.lights[hit->light],
-                              prev_p, ray.d, light_sampled,
-                              light_sampling_pdf(scene, ps, hit->light, prev_p));
+      if (!emission_counted) {
+        const Spectrum<N> Le = light_emission(ps, scene, hit->light);
+        // A path through a smooth boundary that manifold sampling at its last vertex finds too
+        // is weighted against the walk.
+        const double walk =
+            manifold_light_pdf(scene, ps, chain, hit->light, ray.at(hit->t), counters);
+        L += walk > 0 ? policy.emission(Le, true, walk)
+                      : policy.light_hit(Le, scene.lights[hit->light], prev_p, ray.d, light_sampled,
+                                         light_sampling_pdf(scene, ps, hit->light, prev_p));
+      }
       break;
     }
     const SceneObject& obj = scene.objects[hit->object];
@@ -309,12 +319,17 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
     const Vec3 n = outward_normal(obj, p);
     record.surface(obj.surface, ray, hit->t, n);
     if (obj.surface.type == Surface::Type::Emissive) {
-      // As for a sphere light: what the walk to emissive surfaces finds counts there only.
-      if (!emission_counted && dot(ray.d, n) < 0 &&
-          !manifold_covers_surface(scene, chain, hit->object, p, n, counters))
-        L += policy.emission(
-            evaluate(obj.surface.radiance, ps.ch), emitters_sampled,
-            emitters_sampled ? emitter_solid_angle_pdf(scene, hit->object, prev_p, p, n) : 0);
+      // As for a sphere light: what the walk to emissive surfaces finds too is weighted against
+      // it.
+      if (!emission_counted && dot(ray.d, n) < 0) {
+        const double walk = manifold_surface_pdf(scene, ps, chain, hit->object, p, n, counters);
+        L += walk > 0
+                 ? policy.emission(evaluate(obj.surface.radiance, ps.ch), true, walk)
+                 : policy.emission(evaluate(obj.surface.radiance, ps.ch), emitters_sampled,
+                                   emitters_sampled
+                                       ? emitter_solid_angle_pdf(scene, hit->object, prev_p, p, n)
+                                       : 0);
+      }
       break;
     }
     if (depth >= scene.settings.max_depth) break;

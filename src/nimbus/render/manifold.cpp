@@ -43,8 +43,8 @@ struct Traced {
 // method along the ray from near's, within `reach` (relative) of it: the walk's neighbouring
 // directions then cost a few evaluations of F, not a root isolation. Where that fails, or for a
 // non-convex boundary finds a crossing other than the first, the chain's shadow segments are
-// blocked and it brings no light; the walk stays deterministic, which is all the partition
-// asks.
+// blocked and it brings no light; the walk stays deterministic, which is all MIS's
+// weights ask.
 std::optional<double> hit_near(const Tape& tape, const Ray& ray, const Vec3& near, double reach) {
   const double t0 = dot(near - ray.o, ray.d);
   double t = t0;

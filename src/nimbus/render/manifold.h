@@ -7,8 +7,8 @@
 // boundaries", states what it assumes.
 //
 // The walk is deterministic: the same start and target give the same chain. The path loop uses
-// that to partition path space with BSDF and phase sampling (render/integrator.h): a sampled path
-// that reaches a light through such a chain counts only where the walk would not have found it.
+// that to weigh it against BSDF and phase sampling by MIS (render/manifold_light.h): a sampled
+// path that reaches a light through such a chain has the walk's density where the walk finds it.
 
 #include <optional>
 
@@ -48,7 +48,7 @@ struct SpecularChain {
 };
 
 // Most refractions a chain may have before it: the chain needs depth + vertices < max_depth so
-// that the same path sampled by the BSDF would not have been cut short (the partition).
+// that the same path sampled by the BSDF would not have been cut short (MIS's weights).
 inline constexpr int kMaxChainVertices = 2;
 
 // Whether the scene has a solid with a smooth dielectric boundary, the only thing manifold

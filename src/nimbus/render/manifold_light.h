@@ -1,16 +1,17 @@
 #pragma once
 // Manifold next-event estimation in the path loop (render/integrator.h): light that reaches a
 // medium or diffuse vertex through one smooth dielectric solid's boundary (render/manifold.h),
-// and the partition of path space that keeps it from counting twice with BSDF and phase
-// sampling. The light sample is next-event estimation's own: where its straight shadow ray
-// meets a dielectric solid first (or leaves the solid the vertex is in), the chain through that
-// solid to the same light point replaces the shadow ray, which would be blocked. Emissive
-// surfaces, which next-event estimation does not sample, have a walk of their own at each vertex
-// to a point sampled on one of them (render/emitter.h), used only where the straight ray meets a
-// dielectric solid first. A path sampled from the vertex that reaches a sphere light or an
-// emissive surface through the same refractions counts only where that walk, repeated for the
-// point it hit, would not have found it (manifold_covers, manifold_covers_surface): the two
-// estimators share no path, and together miss none that sampling can find.
+// and its MIS weights against BSDF and phase sampling. The light sample is next-event estimation's
+// own: where its straight shadow ray meets a dielectric solid first (or leaves the solid the vertex
+// is in), the chain through that solid to the same light point replaces the shadow ray, which would
+// be blocked. Emissive surfaces, which next-event estimation does not sample, have a walk of their
+// own at each vertex to a point sampled on one of them (render/emitter.h), used only where the
+// straight ray meets a dielectric solid first. A path sampled from the vertex that reaches a sphere
+// light or an emissive surface through the same refractions is weighted against the walk by the
+// power heuristic where that walk, repeated for the point it hit, finds the same chain, and counts
+// alone where it would not (manifold_light_pdf, manifold_surface_pdf). The walk is
+// deterministic, so its density for a path is the light sample's, carried to the vertex's
+// solid angle by the chain's geometry term.
 
 #include <algorithm>
 #include <array>
@@ -30,7 +31,7 @@
 
 namespace nimbus {
 
-// What a path did since it left its last diffuse or medium vertex, for manifold_covers.
+// What a path did since it left its last diffuse or medium vertex, for the MIS weights of its light hits.
 struct ChainRecord {
   ChainStart start;
   Vec3 dir0;       // the direction it left in
@@ -95,29 +96,63 @@ double walk_probability(const Scene& scene, const PathSpectra<N>& ps, const Chai
   return std::max(kMinWalkProbability, std::exp(-tau));
 }
 
+// The share of caustic walks (two refractions, through a solid from outside) to a light with an
+// area that are made, for a light of bounding sphere (center, radius) seen from p: BSDF
+// sampling finds such a chain about in proportion to the solid angle Ω the light subtends,
+// while a walk costs the same whatever the light's size, so walks are made with probability
+// min(1, Ω₀ / Ω). It is part of the walk's density, so MIS weighs it in and the image does not
+// change. Ω₀ from the bench (docs/benchmarks.md, "Light through smooth boundaries").
+inline constexpr double kCausticSolidAngle = 0.01;  // Ω₀, steradians (a 3.2° radius)
+inline double caustic_walk_share(const Vec3& p, const Vec3& center, double radius) {
+  const Vec3 to = center - p;
+  const double d2 = dot(to, to), r2 = radius * radius;
+  const double omega = d2 > r2 ? 2 * kPi * (1 - std::sqrt(1 - r2 / d2)) : 4 * kPi;
+  return std::min(1.0, kCausticSolidAngle / omega);
+}
+
 // What a chain ends on: a light (point, sphere, directional), or an emissive surface.
 struct ChainEnd {
   int light = -1;
   int object = -1;
 };
 
+// What a light sends back along a chain (manifold_term's `emitted`): its radiance per the
+// target's density, and that density in the area across the chain's last direction,
+// pdf_A / cos_y (0 for a delta light, which no other technique samples).
+template <int N>
+struct ChainEmission {
+  Spectrum<N> Le;
+  double pdf_perp = 0;
+};
+
+// The walk's density for a chain in the solid angle of its first direction, divided by the
+// chain's transmission: the light sample's density pdf_perp, carried by the geometry term
+// |dω₀/dA⊥|, times the probability choice_pdf of picking the light and walking. MIS compares it
+// with the scattering pdf at the chain's start (the transmission is the probability that
+// sampling then takes every refraction).
+inline double walk_pdf(const SpecularChain& chain, double pdf_perp, double choice_pdf) {
+  return choice_pdf * pdf_perp / (chain.jacobian * chain.transmission);
+}
+
 // The light through one specular chain from `start` to `target` times the scattering function f
 // at the chain's first direction and the policy's transmittance of its segments, divided by
-// choice_pdf. `emitted(chain)` is the radiance the light sends back along the chain's last
-// direction per the target's density (what turns the walk's geometry term into the vertex's
-// measure). Uses the path's stream for the transmittance.
-template <int N, class Policy, class F, class Emitted>
+// choice_pdf; for a target with an area, weighted by the power heuristic against sampling f
+// (pdf f_pdf). `emitted(chain)` is what the light sends back along the chain's last direction
+// (ChainEmission). Uses the path's stream for the transmittance.
+template <int N, class Policy, class F, class Pdf, class Emitted>
 Spectrum<N> manifold_term(const Scene& scene, const PathSpectra<N>& ps, const ChainStart& start,
                           const ChainShape& shape, const ChainTarget& target, const ChainSeed& seed,
                           const ChainEnd& end, Emitted&& emitted, double choice_pdf,
-                          const Policy& policy, F&& f, Rng& rng, Counters& counters) {
+                          const Policy& policy, F&& f, Pdf&& f_pdf, Rng& rng, Counters& counters) {
   const auto chain = solve_chain(scene, start, target, shape, seed, counters.manifold);
   if (!chain) return Spectrum<N>(0.0);
   const Spectrum<N> fv = f(chain->dir0);
   if (fv.is_black()) return Spectrum<N>(0.0);
-  const Spectrum<N> Le = emitted(*chain);
-  if (Le.is_black()) return Spectrum<N>(0.0);
-  const Spectrum<N> fLi = fv * Le * (chain->jacobian * chain->transmission / choice_pdf);
+  const ChainEmission<N> e = emitted(*chain);
+  if (e.Le.is_black()) return Spectrum<N>(0.0);
+  const Spectrum<N> fLi = fv * e.Le * (chain->jacobian * chain->transmission / choice_pdf);
+  const double rho =
+      e.pdf_perp > 0 ? f_pdf(chain->dir0) / walk_pdf(*chain, e.pdf_perp, choice_pdf) : 0.0;
   // The straight segments: start to the boundary, across the solid, out to the light.
   std::array<ShadowSegment, kMaxChainVertices + 1> segments;
   const int k = chain->vertices;
@@ -142,39 +177,44 @@ Spectrum<N> manifold_term(const Scene& scene, const PathSpectra<N>& ps, const Ch
   segments[size_t(k)] = {{o, d}, t_last, -1, end.light};
   Spectrum<N> out;
   if (!policy.chain_term(scene, ps, std::span<const ShadowSegment>(segments.data(), size_t(k + 1)),
-                         fLi, rng, counters, out))
+                         fLi, rho, rng, counters, out))
     return Spectrum<N>(0.0);
   return out;
 }
 
+// The area density with which next-event estimation from p samples the point y of sphere light
+// i: its cone's solid-angle density times cos / d² at y (n_y, the outward normal there).
+inline double sphere_point_pdf(const Light& light, const Vec3& p, const Vec3& y, const Vec3& n_y) {
+  const Vec3 to = y - p;
+  const double d2 = dot(to, to), d = std::sqrt(d2);
+  return light_pdf(light, p, to / d) * dot(n_y, -to / d) / d2;
+}
+
 // What light i sends back along a chain to its sample ls from p (manifold_term's `emitted`):
 // its emission, times for a sphere light cos_y / pdf_A, the point having been sampled in the cone
-// the light subtends from p (area density pdf_ω cos / d² there; the chain leaves it at cos_y).
-// The walk's geometry term is then E |dω₀/dω| for a directional light, I |dω₀/dA⊥| for a point.
+// the light subtends from p; the chain leaves it at cos_y. The walk's geometry term is then
+// E |dω₀/dω| for a directional light, I |dω₀/dA⊥| for a point.
 template <int N>
-Spectrum<N> light_chain_emission(const Scene& scene, const PathSpectra<N>& ps, int i,
-                                 const ChainTarget& target, const LightSample& ls,
-                                 const SpecularChain& chain) {
+ChainEmission<N> light_chain_emission(const Scene& scene, const PathSpectra<N>& ps, int i,
+                                      const ChainTarget& target, const LightSample& ls,
+                                      const SpecularChain& chain) {
   const Light& light = scene.lights[size_t(i)];
-  double g = 1;
-  if (light.type == Light::Type::Sphere) {
-    const Vec3 n_y = normalize(target.point - light.center);
-    const double cos_y = dot(n_y, -chain.dir_out), cos_p = dot(n_y, -ls.wi);
-    const double pdf_area = ls.pdf * cos_p / (ls.distance * ls.distance);
-    if (!(cos_y > 0) || !(pdf_area > 0)) return Spectrum<N>(0.0);
-    g = cos_y / pdf_area;
-  }
-  return light_emission(ps, scene, i) * g;
+  if (light.type != Light::Type::Sphere) return {light_emission(ps, scene, i), 0.0};
+  const Vec3 n_y = normalize(target.point - light.center);
+  const double cos_y = dot(n_y, -chain.dir_out), cos_p = dot(n_y, -ls.wi);
+  const double pdf_area = ls.pdf * cos_p / (ls.distance * ls.distance);
+  if (!(cos_y > 0) || !(pdf_area > 0)) return {Spectrum<N>(0.0), 0.0};
+  return {light_emission(ps, scene, i) * (cos_y / pdf_area), pdf_area / cos_y};
 }
 
 // What an emissive surface of radiance Le sends back along a chain to its point e: Le times
 // cos_y / pdf_A (render/emitter.h), where the chain meets its outer side.
 template <int N>
-Spectrum<N> surface_chain_emission(const Spectrum<N>& Le, const EmitterPoint& e,
-                                   const SpecularChain& chain) {
+ChainEmission<N> surface_chain_emission(const Spectrum<N>& Le, const EmitterPoint& e,
+                                        const SpecularChain& chain) {
   const double cos_y = dot(e.n, -chain.dir_out);
-  if (!(cos_y > 0)) return Spectrum<N>(0.0);
-  return Le * (cos_y / e.pdf_area);
+  if (!(cos_y > 0)) return {Spectrum<N>(0.0), 0.0};
+  return {Le * (cos_y / e.pdf_area), e.pdf_area / cos_y};
 }
 
 // Whether a chain through shape's solid can reach the emitter's point e on its outer side: its
@@ -209,19 +249,28 @@ inline bool walks_to_emitters(const Scene& scene) {
 
 namespace manifold_detail {
 
-// Whether the walk from the record's start to y goes through the same refractions to the same
-// first direction as the sampled path did.
-inline bool walk_finds(const Scene& scene, const ChainRecord& chain, const Vec3& y,
-                       Counters& counters) {
+// The chain the walk from the record's start to y finds, where it goes through the same
+// refractions to the same first direction as the sampled path did, with the probability of
+// making that walk (walk_probability).
+struct FoundChain {
+  SpecularChain chain;
+  double q;
+};
+template <int N>
+std::optional<FoundChain> walk_finds(const Scene& scene, const PathSpectra<N>& ps,
+                                     const ChainRecord& chain, const Vec3& y, double caustic_share,
+                                     Counters& counters) {
   const int vertices = chain.start.inside >= 0 ? 1 : 2;
   const ChainTarget target{y, {}, false};
   const auto shape = chain_shape(scene, chain.start, target);
-  if (!shape || shape->solid != chain.solid || shape->vertices != vertices) return false;
+  if (!shape || shape->solid != chain.solid || shape->vertices != vertices) return std::nullopt;
   ++counters.manifold.checks;
   ManifoldCounters not_counted;  // a check is not a walk of next-event estimation
-  const auto found = solve_chain(scene, chain.start, target, *shape,
-                                 seed_chain(scene, chain.start, target, *shape), not_counted);
-  return found && same_direction(found->dir0, chain.dir0);
+  const ChainSeed seed = seed_chain(scene, chain.start, target, *shape);
+  const auto found = solve_chain(scene, chain.start, target, *shape, seed, not_counted);
+  if (!found || !same_direction(found->dir0, chain.dir0)) return std::nullopt;
+  const double share = vertices == 2 ? caustic_share : 1.0;
+  return FoundChain{*found, share * walk_probability(scene, ps, chain.start, *shape, seed)};
 }
 
 // Whether the record is a chain of refractions through one solid that the walk could have made.
@@ -232,36 +281,53 @@ inline bool walkable(const Scene& scene, const ChainRecord& chain) {
 
 }  // namespace manifold_detail
 
-// Whether manifold next-event estimation at the record's start covers the sampled path that
-// reached sphere light i at y: it picks the light there, samples y, and its walk for y goes
-// through the same refractions to the same first direction. Such a path is then counted by the
-// walk alone.
+// The density (walk_pdf) with which manifold next-event estimation at the record's start
+// samples the path that reached sphere light i at y: it picks the light there, samples y, and
+// its walk for y goes through the same refractions to the same first direction; 0 where it
+// would not. The path is then weighted against it by the power heuristic.
 template <int N>
-bool manifold_covers(const Scene& scene, const PathSpectra<N>& ps, const ChainRecord& chain, int i,
-                     const Vec3& y, Counters& counters) {
-  if (!manifold_detail::walkable(scene, chain)) return false;
+double manifold_light_pdf(const Scene& scene, const PathSpectra<N>& ps, const ChainRecord& chain,
+                          int i, const Vec3& y, Counters& counters) {
+  if (!manifold_detail::walkable(scene, chain)) return 0;
   const Light& light = scene.lights[size_t(i)];
-  if (light.type != Light::Type::Sphere) return false;
+  if (light.type != Light::Type::Sphere) return 0;
   const Vec3 p = chain.start.p;
-  if (scene.settings.light_sampling == RenderSettings::LightSampling::One &&
-      !(light_choice_pdf(scene, ps, i, p) > 0))
-    return false;
+  const double choice_pdf = scene.settings.light_sampling == RenderSettings::LightSampling::One
+                                ? light_choice_pdf(scene, ps, i, p)
+                                : 1.0;
+  if (!(choice_pdf > 0)) return 0;
   // Next-event estimation samples the point the straight ray from p meets first, in the cone.
   const double dist = length(y - p);
   const Vec3 dir = (y - p) / dist;
-  if (!(light_pdf(light, p, dir) > 0)) return false;
+  if (!(light_pdf(light, p, dir) > 0)) return 0;
   const auto t = intersect_light(light, {p, dir}, 0, kInf);
-  if (!t || std::abs(*t - dist) > 1e-6 * dist) return false;
-  return manifold_detail::walk_finds(scene, chain, y, counters);
+  if (!t || std::abs(*t - dist) > 1e-6 * dist) return 0;
+  const auto found = manifold_detail::walk_finds(
+      scene, ps, chain, y, caustic_walk_share(p, light.center, light.radius), counters);
+  if (!found) return 0;
+  const Vec3 n_y = normalize(y - light.center);
+  const double cos_y = dot(n_y, -found->chain.dir_out);
+  if (!(cos_y > 0)) return 0;
+  return walk_pdf(found->chain, sphere_point_pdf(light, p, y, n_y) / cos_y, choice_pdf * found->q);
 }
 
 // The same for a sampled path that reached the emissive surface of `object` at y (outward normal
-// n): the walk to emitters samples y with positive density there (render/emitter.h).
-inline bool manifold_covers_surface(const Scene& scene, const ChainRecord& chain, int object,
-                                    const Vec3& y, const Vec3& n, Counters& counters) {
-  if (!walks_to_emitters(scene) || !manifold_detail::walkable(scene, chain)) return false;
-  if (!(emitter_point_pdf(scene, object, y, n) > 0)) return false;
-  return manifold_detail::walk_finds(scene, chain, y, counters);
+// n): the walk to emitters picks one uniformly and samples y on it (render/emitter.h).
+template <int N>
+double manifold_surface_pdf(const Scene& scene, const PathSpectra<N>& ps, const ChainRecord& chain,
+                            int object, const Vec3& y, const Vec3& n, Counters& counters) {
+  if (!walks_to_emitters(scene) || !manifold_detail::walkable(scene, chain)) return 0;
+  const double pdf_area = emitter_point_pdf(scene, object, y, n);
+  if (!(pdf_area > 0)) return 0;
+  const Box& b = scene.objects[size_t(object)].bounds;
+  const auto found = manifold_detail::walk_finds(
+      scene, ps, chain, y, caustic_walk_share(chain.start.p, b.center(), 0.5 * length(b.extent())),
+      counters);
+  if (!found) return 0;
+  const double cos_y = dot(n, -found->chain.dir_out);
+  if (!(cos_y > 0)) return 0;
+  return walk_pdf(found->chain, pdf_area / cos_y,
+                  found->q / static_cast<double>(scene.emitters.size()));
 }
 
 }  // namespace nimbus

@@ -63,8 +63,8 @@ Spectrum<N> mirror_light(const Scene& scene, const PathSpectra<N>& ps, const Vec
   }
   if (Le.is_black()) return Spectrum<N>(0.0);
   Spectrum<N> out;
-  if (!policy.chain_term(scene, ps, std::span<const ShadowSegment>(&seg, 1), Le * F, rng, counters,
-                         out))
+  if (!policy.chain_term(scene, ps, std::span<const ShadowSegment>(&seg, 1), Le * F, 0.0, rng,
+                         counters, out))
     return Spectrum<N>(0.0);
   return out;
 }

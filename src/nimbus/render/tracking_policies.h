@@ -83,18 +83,20 @@ class PlainTracking {
   }
 
   // Next-event estimation along a specular chain found by manifold sampling: the transmittance
-  // of its segments, each in its own medium. The chain is the only technique for its paths (the
-  // partition in render/integrator.h), so it carries no MIS weight, as a delta light.
+  // of its segments, each in its own medium. fLi is already divided by the walk's density p_w;
+  // rho = p_f / p_w, the density with which sampling f would take the same path over it, weighs
+  // the two by the power heuristic (render/manifold_light.h); 0 for a delta light, whose chain
+  // is the only technique for its paths.
   bool chain_term(const Scene& scene, const PathSpectra<N>& ps,
-                  std::span<const ShadowSegment> segments, const Spectrum<N>& fLi, Rng& rng,
-                  Counters& counters, Spectrum<N>& out) const {
+                  std::span<const ShadowSegment> segments, const Spectrum<N>& fLi, double rho,
+                  Rng& rng, Counters& counters, Spectrum<N>& out) const {
     Spectrum<N> T(1.0);
     for (const ShadowSegment& s : segments) {
       T *= transmittance(scene, ps, s.ray, s.t_max, s.light, s.inside, events_.channel, boost_,
                          beta_ * fLi * T, rng, counters);
       if (T.is_black()) return false;
     }
-    out = fLi * T;
+    out = fLi * T * power_heuristic(1.0, rho);
     return true;
   }
 
@@ -171,16 +173,16 @@ class HeroTracking {
   }
 
   // As PlainTracking::chain_term: hero ratio tracking over every segment into one T_ray, r_u and
-  // r_l, weighted as a delta light's.
+  // r_l, weighted as light_term's with the pdfs over p_w: f Li T_ray / avg(r_u (r_l + ρ r_u)).
   bool chain_term(const Scene& scene, const PathSpectra<N>& ps,
-                  std::span<const ShadowSegment> segments, const Spectrum<N>& fLi, Rng& rng,
-                  Counters& counters, Spectrum<N>& out) const {
+                  std::span<const ShadowSegment> segments, const Spectrum<N>& fLi, double rho,
+                  Rng& rng, Counters& counters, Spectrum<N>& out) const {
     MisPath<N> s;
     for (const ShadowSegment& seg : segments)
       if (!transmittance_mis(scene, ps, seg.ray, seg.t_max, seg.light, seg.inside, hero_, boost_,
                              path_.beta * fLi, s, rng, counters))
         return false;
-    out = fLi * s.beta / (path_.r_u * s.r_l).average();
+    out = fLi * s.beta / (path_.r_u * (s.r_l + s.r_u * rho)).average();
     return true;
   }
 
