@@ -7,6 +7,7 @@
 #include <cmath>
 #include <complex>
 #include <cstdint>
+#include <cstdio>
 #include <functional>
 #include <string>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "nimbus/math/constants.h"
 #include "nimbus/math/rng.h"
 #include "nimbus/render/material.h"
+#include "nimbus/render/sampling.h"
 #include "support/stats.h"
 
 namespace nimbus {
@@ -206,9 +208,10 @@ bool scatter(const Vec3& wo, const Vec3& wm, bool refract, double e, Vec3& wi) {
 HemisphereBins bins_for(const Case& cs, bool transmission) {
   const Vec3 wo = cs.wo;
   const double sign = wo.z > 0 ? 1.0 : -1.0;
-  const double e = wo.z > 0 ? cs.eta : 1 / cs.eta;
   const double side = transmission ? -sign : sign;
   const double phi_o = std::atan2(wo.y, wo.x);
+  if (transmission && cs.kind == Kind::Conductor) return {side, kPi / 2, phi_o + kPi, 1, 2};
+  const double e = cs.kind == Kind::Conductor ? 1.0 : wo.z > 0 ? cs.eta : 1 / cs.eta;
   const Vec3 n{0, 0, sign};
   Vec3 wi;
   // Facets at the horizon, (wo + e wi).z = 0, refract wo to |wi.z| = |wo.z|/e.
@@ -227,6 +230,13 @@ HemisphereBins bins_for(const Case& cs, bool transmission) {
     }
     w_theta = std::max(w_theta, std::abs(std::acos(std::abs(wi.z)) - theta_c));
     w_phi = std::max(w_phi, std::abs(wrap_angle(std::atan2(wi.y, wi.x) - phi_c)));
+  }
+  // Refraction compresses the facets' spread by about |1 − 1/e| (a thin prism), which matters
+  // where η is near 1 and the lobe is broad.
+  if (transmission) {
+    const double squeeze = std::max(0.05, 2 * std::abs(1 - 1 / e));
+    w_theta = std::min(w_theta, squeeze);
+    w_phi = std::min(w_phi, 2 * squeeze);
   }
   return {side, theta_c, phi_c, w_theta, w_phi, edge};
 }
@@ -392,28 +402,251 @@ TEST(MicrofacetFresnel, LosslessMetalsReflectEverything) {
 
 // ---------------------------------------------------------------------------------------------
 
+std::string sci(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", x);
+  return buf;
+}
+
+constexpr int kChiSquareSamples = 10000;
+
+// One chi-square per acceptance case, computed once for the tests below.
+const std::vector<ChiSquare>& chi_squares() {
+  static const std::vector<ChiSquare> results = [] {
+    std::vector<ChiSquare> r;
+    const std::vector<Case> cases = acceptance_cases();
+    for (size_t i = 0; i < cases.size(); ++i)
+      r.push_back(chi_square(cases[i], kChiSquareSamples, i));
+    return r;
+  }();
+  return results;
+}
+
 TEST(MicrofacetSampling, ChiSquareOverTheSphere) {
   // Every case's sampled directions against its pdf, integrated over bins of the whole sphere
   // (reflection and transmission hemispheres) plus a bin for discarded samples. Bins follow the
-  // lobe (bins_for), so that at α = 0.01 the lobe still fills dozens of bins. Significance 1e-4
-  // for the whole test, Šidák-corrected over the cases.
-  constexpr int kSamples = 10000;
+  // lobe (bins_for), so that at α = 0.01 it still fills over a hundred bins. Significance 1e-4
+  // for the whole test, Šidák-corrected over the cases. (With 400 000 samples, 40 times these,
+  // the cases with the lowest p here give p from 0.29 to 0.99.)
   const std::vector<Case> cases = acceptance_cases();
   const double alpha_case = -std::expm1(std::log1p(-1e-4) / double(cases.size()));
   double worst_p = 1;
   int fewest_dof = 1 << 30;
   for (size_t i = 0; i < cases.size(); ++i) {
-    const ChiSquare r = chi_square(cases[i], kSamples, i);
+    const ChiSquare& r = chi_squares()[i];
     worst_p = std::min(worst_p, r.p);
     fewest_dof = std::min(fewest_dof, r.dof);
     EXPECT_LT(r.chi2, test::chi_square_critical(r.dof, alpha_case))
         << cases[i].name() << ": chi2 " << r.chi2 << ", dof " << r.dof << ", p " << r.p;
-    EXPECT_LE(r.mass, 1 + 1e-3) << cases[i].name();
-    EXPECT_GE(r.dof, 15) << cases[i].name() << ": too few bins to test the lobe's shape";
+    EXPECT_GE(r.dof, 25) << cases[i].name() << ": too few bins to test the lobe's shape";
   }
   RecordProperty("cases", int(cases.size()));
-  RecordProperty("worst_p", std::to_string(worst_p));
+  RecordProperty("worst_p", sci(worst_p));
   RecordProperty("fewest_dof", fewest_dof);
+}
+
+TEST(MicrofacetSampling, PdfIntegratesToTheKeptFraction) {
+  // ∫ pdf over the sphere is at most 1, and equals the fraction of samples kept: 1 where none
+  // is discarded (the bins' quadrature is good to ~4e-4 over a hemisphere, at worst).
+  const std::vector<Case> cases = acceptance_cases();
+  int none_discarded = 0;
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const ChiSquare& r = chi_squares()[i];
+    const double kept = 1 - double(r.discarded) / kChiSquareSamples;
+    EXPECT_LE(r.mass, 1 + 1e-3) << cases[i].name();
+    EXPECT_NEAR(r.mass, kept, 4 * std::sqrt(kept * (1 - kept) / kChiSquareSamples) + 1e-3)
+        << cases[i].name();
+    if (r.discarded == 0) {
+      ++none_discarded;
+      EXPECT_NEAR(r.mass, 1, 1e-3) << cases[i].name();
+    }
+  }
+  EXPECT_GE(none_discarded, 5);
+}
+
+// The ratio of two quantities that should agree, as a relative error; 0 when both are 0.
+double relative_error(double a, double b) {
+  const double scale = std::max(std::abs(a), std::abs(b));
+  return scale > 0 ? std::abs(a - b) / scale : 0.0;
+}
+
+TEST(MicrofacetSampling, WeightAndPdfMatchEvaluation) {
+  // A kept sample's pdf is what the pdf function gives for its direction, its weight f·|wi.z|/pdf
+  // from the evaluation functions, and `reflected` says which side wi is on. Both recompute the
+  // facet normal from (wo, wi); at α = 0.01 a rounding of wm moves D by up to ~4/α ulps.
+  double worst_pdf = 0, worst_weight = 0;
+  int kept = 0;
+  for (const Case& cs : acceptance_cases()) {
+    Rng rng(7, uint64_t(cs.alpha * 1000 + cs.theta_deg + 10 * cs.eta + (cs.side > 0)));
+    for (int n = 0; n < 2000; ++n) {
+      const MicrofacetSample s = cs.sample(rng);
+      ASSERT_TRUE(std::isfinite(s.pdf) && std::isfinite(s.weight)) << cs.name();
+      if (s.pdf == 0) {
+        EXPECT_EQ(s.weight, 0) << cs.name();
+        continue;
+      }
+      ++kept;
+      const double pdf = cs.pdf(s.wi), f = cs.f(s.wi);
+      ASSERT_GT(pdf, 0) << cs.name();
+      worst_pdf = std::max(worst_pdf, relative_error(s.pdf, pdf));
+      worst_weight = std::max(worst_weight, relative_error(s.weight, f * std::abs(s.wi.z) / pdf));
+      EXPECT_EQ(s.reflected, s.wi.z * cs.wo.z > 0) << cs.name();
+      EXPECT_TRUE(s.weight > 0 && s.weight <= 1) << cs.name() << ": " << s.weight;
+      EXPECT_NEAR(length(s.wi), 1, 1e-12) << cs.name();
+    }
+  }
+  EXPECT_GT(kept, 200000);
+  EXPECT_LT(worst_pdf, 1e-9);
+  EXPECT_LT(worst_weight, 1e-9);
+  RecordProperty("worst_pdf_error", sci(worst_pdf));
+  RecordProperty("worst_weight_error", sci(worst_weight));
+}
+
+TEST(MicrofacetReciprocity, ConductorAndDielectric) {
+  // Pairs where the BSDF matters (wi sampled from wo) and uniform ones: the conductor and the
+  // dielectric's reflection are symmetric; its transmission obeys
+  // f(wo, wi)/n(wi)² = f(wi, wo)/n(wo)² (outside n = 1, inside n = η).
+  int transmitted = 0;
+  double worst = 0;
+  for (const Case& cs : acceptance_cases()) {
+    Rng rng(11, uint64_t(cs.alpha * 1000 + cs.theta_deg + 10 * cs.eta + (cs.side > 0)));
+    for (int n = 0; n < 400; ++n) {
+      const MicrofacetSample s = cs.sample(rng);
+      Vec3 wo = cs.wo, wi = s.wi;
+      if (n % 2) {
+        wo = sample_uniform_sphere(rng.uniform(), rng.uniform());
+        wi = sample_uniform_sphere(rng.uniform(), rng.uniform());
+      } else if (s.pdf == 0) {
+        continue;
+      }
+      if (cs.kind == Kind::Conductor) {
+        worst = std::max(worst, relative_error(conductor_microfacet(cs.alpha, wo, wi),
+                                               conductor_microfacet(cs.alpha, wi, wo)));
+        continue;
+      }
+      // Near the refraction cut-offs, where wo·wm or wi·wm → 0 and f with it, each direction
+      // computes those cosines with a cancellation: uniform pairs there are left out.
+      const double e = wo.z > 0 ? cs.eta : 1 / cs.eta;
+      if (wo.z * wi.z < 0 &&
+          (std::abs(1 + e * dot(wo, wi)) < 1e-2 || std::abs(e + dot(wo, wi)) < 1e-2))
+        continue;
+      const auto n2 = [&](const Vec3& w) { return w.z > 0 ? 1.0 : cs.eta * cs.eta; };
+      const double forward = dielectric_microfacet(cs.alpha, cs.eta, wo, wi) / n2(wi);
+      const double backward = dielectric_microfacet(cs.alpha, cs.eta, wi, wo) / n2(wo);
+      transmitted += wo.z * wi.z < 0 && forward > 0;
+      worst = std::max(worst, relative_error(forward, backward));
+    }
+  }
+  EXPECT_GT(transmitted, 5000);
+  EXPECT_LT(worst, 1e-9);
+  RecordProperty("worst_reciprocity_error", sci(worst));
+}
+
+TEST(MicrofacetSampling, RefractionCannotBendBackwards) {
+  // Entering a denser medium, wi beyond the plane that holds wo and the normal (on wo's side of
+  // it) needs a facet facing away from wo: f and pdf are 0 (Walter et al. 2007's half-vector
+  // test), and so is wi = −wo at η = 1, where no facet exists.
+  const Vec3 wo = incident(60, 1);
+  const Vec3 back{wo.x, wo.y, -wo.z};
+  EXPECT_EQ(dielectric_microfacet(0.5, 1.5, wo, back), 0);
+  EXPECT_EQ(dielectric_microfacet_pdf(0.5, 1.5, wo, back), 0);
+  EXPECT_EQ(dielectric_microfacet(0.5, 1.0, wo, -wo), 0);
+  EXPECT_EQ(dielectric_microfacet_pdf(0.5, 1.0, wo, -wo), 0);
+  // Straight through is possible (the facet facing wo), the mirror image behind is not.
+  EXPECT_GT(dielectric_microfacet(0.5, 1.5, wo, -wo), 0);
+  EXPECT_EQ(conductor_microfacet(0.5, wo, -wo), 0);
+  EXPECT_EQ(conductor_microfacet_pdf(0.5, wo, back), 0);
+}
+
+TEST(MicrofacetDielectric, TinyRoughnessIsTheSmoothDielectric) {
+  // α below the clamp samples what render/material.h's smooth dielectric does with the same
+  // number, from either side, with weight 1: the conventions (η's direction, wo's) agree. GGX's
+  // tail (tilts beyond t have probability ~α²/t²) lets a few directions stray further.
+  Rng rng(5);
+  int compared = 0, close = 0;
+  for (double theta : {0.0, 20.0, 45.0, 70.0})
+    for (double side : {1.0, -1.0})
+      for (double eta : {1.1, 1.5, 2.4}) {
+        const Vec3 wo = incident(theta, side);
+        for (int n = 0; n < 50; ++n) {
+          const double uc = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
+          const MicrofacetSample s = sample_dielectric_microfacet(1e-7, eta, wo, uc, u1, u2);
+          const DielectricSample smooth = sample_dielectric(wo, {0, 0, 1}, eta, uc);
+          if (std::abs(uc - smooth.F) < 1e-3) continue;  // F moved with the facet
+          ASSERT_GT(s.pdf, 0);
+          EXPECT_EQ(s.reflected, smooth.reflected) << theta << " " << side << " " << eta;
+          EXPECT_LT(length(s.wi - smooth.wi), 0.05) << theta << " " << side << " " << eta;
+          EXPECT_GT(s.weight, 1 - 1e-6);
+          ++compared;
+          close += length(s.wi - smooth.wi) < 1e-3;
+        }
+      }
+  EXPECT_GT(close, 0.95 * compared);
+}
+
+TEST(MicrofacetDegenerate, FiniteForGrazingAndExtremeInputs) {
+  // Horizon and near-horizon directions, normal incidence (no azimuth to stretch along), α = 0,
+  // the edges of the unit square, η = 1: nothing is NaN or infinite, pdfs and f are ≥ 0, kept
+  // samples have weights in [0, 1].
+  const std::vector<Vec3> dirs{{0, 0, 1},
+                               {0, 0, -1},
+                               {1, 0, 0},
+                               {0.6, 0.8, 0},
+                               incident(89.9999999, 1),
+                               incident(89.9999999, -1),
+                               {1, 0, 1e-160},
+                               {1, 0, -1e-300},
+                               incident(45, 1)};
+  const double u_max = std::nextafter(1.0, 0.0);
+  for (double alpha : {0.0, 1e-9, 0.01, 1.0})
+    for (double eta : {1.0, 1.5, 1 / 1.5})
+      for (const Vec3& wo : dirs) {
+        for (const Vec3& wi : dirs)
+          for (const double v :
+               {ggx_d(alpha, wi), smith_g(alpha, wo, wi), conductor_microfacet(alpha, wo, wi),
+                conductor_microfacet_pdf(alpha, wo, wi), dielectric_microfacet(alpha, eta, wo, wi),
+                dielectric_microfacet_pdf(alpha, eta, wo, wi)})
+            EXPECT_TRUE(std::isfinite(v) && v >= 0) << alpha << " " << eta;
+        for (double u1 : {0.0, 0.5, u_max})
+          for (double u2 : {0.0, 0.25, u_max})
+            for (double uc : {0.0, u_max}) {
+              const Vec3 wm = sample_visible_normal(alpha, wo, u1, u2);
+              EXPECT_TRUE(std::isfinite(wm.x + wm.y + wm.z));
+              for (const MicrofacetSample& s :
+                   {sample_conductor_microfacet(alpha, wo, u1, u2),
+                    sample_dielectric_microfacet(alpha, eta, wo, uc, u1, u2)}) {
+                EXPECT_TRUE(std::isfinite(s.pdf) && s.pdf >= 0);
+                EXPECT_TRUE(s.weight >= 0 && s.weight <= 1);
+                EXPECT_TRUE(std::isfinite(s.wi.x + s.wi.y + s.wi.z));
+              }
+            }
+      }
+}
+
+TEST(MicrofacetConductor, SingleScatteringAlbedoOfAPerfectMirrorMetal) {
+  // Directional albedo ∫ f |wi.z| dwi of the F = 1 conductor: by quadrature of f and by the
+  // mean of sampled weights. Single scattering loses what leaves after more than one bounce on
+  // the facets: at α = 1 and 45°, 62% of the energy (the number for the compensation work; a
+  // separate 400 × 400 midpoint quadrature of Walter's formulas gives 0.376775).
+  const auto albedo = [](double alpha, const Vec3& wo) {
+    const HemisphereBins bins(1, 0, kAzimuth + kPi, 1, 2);
+    return integral(
+        bins, [&](const Vec3& wi) { return conductor_microfacet(alpha, wo, wi) * wi.z; }, 1e-7,
+        1e-6, 4);
+  };
+  const Vec3 wo = incident(45, 1);
+  const double quadrature = albedo(1, wo);
+  test::MeanVar mc;
+  Rng rng(3);
+  for (int n = 0; n < 20000; ++n)
+    mc.add(sample_conductor_microfacet(1, wo, rng.uniform(), rng.uniform()).weight);
+  EXPECT_NEAR(mc.mean, quadrature, 4 * mc.std_error());
+  EXPECT_NEAR(quadrature, 0.37678, 2e-5);
+  RecordProperty("albedo_alpha1_45deg", sci(quadrature));
+  // Smoother surfaces lose less, down to nothing.
+  EXPECT_LT(quadrature, albedo(0.5, wo));
+  EXPECT_LT(albedo(0.5, wo), albedo(0.2, wo));
+  EXPECT_GT(albedo(0.05, wo), 0.99);
 }
 
 }  // namespace microfacet_test

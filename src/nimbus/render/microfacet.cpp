@@ -35,6 +35,7 @@ struct DielectricFacet {
   Vec3 wm;
   double eta = 1;  // eta_seen_from(wo)
   double cos_o = 0, cos_i = 0;
+  double len2 = 0;  // |wo + eta wi|² = (wo·wm + eta wi·wm)² when refracting, > 0
   bool reflected = false;
 };
 
@@ -46,9 +47,9 @@ bool find_dielectric_facet(double eta, const Vec3& wo, const Vec3& wi, Dielectri
   facet.reflected = zz > 0;
   facet.eta = eta_seen_from(eta, wo);
   Vec3 h = facet.reflected ? wo + wi : wo + wi * facet.eta;
-  const double len2 = dot(h, h);
-  if (!(len2 > 0)) return false;
-  h = h / std::sqrt(len2);
+  facet.len2 = dot(h, h);
+  if (!(facet.len2 > 0)) return false;
+  h = h / std::sqrt(facet.len2);
   if (h.z * wo.z < 0) h = -h;
   facet.wm = h;
   facet.cos_o = dot(wo, h);
@@ -58,10 +59,9 @@ bool find_dielectric_facet(double eta, const Vec3& wo, const Vec3& wi, Dielectri
 }
 
 // The Jacobian |dwm/dwi| of refraction, n_i² |wi·wm| / (n_o wo·wm + n_i wi·wm)² with n_o = 1
-// (Walter et al. 2007, eq. 17).
-double refraction_jacobian(double eta, double cos_o, double cos_i) {
-  const double den = cos_o + eta * cos_i;
-  return eta * eta * std::abs(cos_i) / (den * den);
+// (Walter et al. 2007, eq. 17); den2 is the denominator, > 0.
+double refraction_jacobian(double eta, double cos_i, double den2) {
+  return eta * eta * std::abs(cos_i) / den2;
 }
 
 }  // namespace
@@ -121,7 +121,7 @@ double visible_normal_pdf(double alpha, const Vec3& wo, const Vec3& wm) {
 
 double fresnel_conductor(double cos_i, double eta, double k) {
   const double c = std::clamp(cos_i, 0.0, 1.0);
-  const double c2 = c * c, s2 = 1 - c2;
+  const double s2 = 1 - c * c;
   // w = a + i b = √(η̃² − sin²θ) = η̃ cos θ_t, the principal root (a, b ≥ 0), η̃ = η + i k.
   const double re = eta * eta - k * k - s2, im = 2 * eta * k;
   // The larger part first, the other from 2ab = im: no cancellation when k or η dominates.
@@ -139,8 +139,8 @@ double fresnel_conductor(double cos_i, double eta, double k) {
   const double pr = re * c + s2 * c, pi = im * c;  // η̃² cos θ = (re + sin²θ + i im) cos θ
   const double rp_num = (pr - a) * (pr - a) + (pi - b) * (pi - b);
   const double rp_den = (pr + a) * (pr + a) + (pi + b) * (pi + b);
-  // Both denominators vanish only at grazing incidence on a matched interface (η̃ = 1): the
-  // limit along the angle is total reflection, as fresnel_dielectric gives.
+  // Both denominators vanish only at grazing incidence on a matched interface (η̃ = 1): 1 there,
+  // as fresnel_dielectric gives.
   const double rs2 = rs_den > 0 ? rs_num / rs_den : 1.0;
   const double rp2 = rp_den > 0 ? rp_num / rp_den : 1.0;
   return 0.5 * (rs2 + rp2);
@@ -190,7 +190,7 @@ double dielectric_microfacet(double alpha, double eta, const Vec3& wo, const Vec
   const double zz = std::abs(wo.z * wi.z);
   if (h.reflected) return F * dg / (4 * zz);
   // Walter et al. 2007, eq. 21, times (n_i/n_o)²: no radiance scaling across the interface.
-  return (1 - F) * dg * h.cos_o * refraction_jacobian(h.eta, h.cos_o, h.cos_i) / zz;
+  return (1 - F) * dg * h.cos_o * refraction_jacobian(h.eta, h.cos_i, h.len2) / zz;
 }
 
 double dielectric_microfacet_pdf(double alpha, double eta, const Vec3& wo, const Vec3& wi) {
@@ -199,7 +199,7 @@ double dielectric_microfacet_pdf(double alpha, double eta, const Vec3& wo, const
   const double pm = visible_normal_pdf(alpha, wo, h.wm);
   const double F = fresnel_dielectric(h.cos_o, h.eta);
   if (h.reflected) return pm * F / (4 * h.cos_o);
-  return pm * (1 - F) * refraction_jacobian(h.eta, h.cos_o, h.cos_i);
+  return pm * (1 - F) * refraction_jacobian(h.eta, h.cos_i, h.len2);
 }
 
 MicrofacetSample sample_dielectric_microfacet(double alpha, double eta, const Vec3& wo,
@@ -222,8 +222,9 @@ MicrofacetSample sample_dielectric_microfacet(double alpha, double eta, const Ve
     // total internal reflection.
     const double cos_t = std::sqrt(std::max(0.0, 1 - (1 - c * c) / (e * e)));
     s.wi = -wo / e + s.wm * (c / e - cos_t);
-    if (!(wo.z * s.wi.z < 0)) return {};
-    s.pdf = pm * (1 - F) * refraction_jacobian(e, c, -cos_t);
+    const double den = c - e * cos_t;  // 0 only when e = 1: straight through, no density
+    if (!(wo.z * s.wi.z < 0) || !(den * den > 0)) return {};
+    s.pdf = pm * (1 - F) * refraction_jacobian(e, cos_t, den * den);
   }
   if (!(s.pdf > 0 && s.pdf < kInf)) return {};
   s.weight = sample_weight(alpha, wo, s.wi);

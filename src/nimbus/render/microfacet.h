@@ -12,10 +12,10 @@
 // the same facet with its normal flipped, and the distribution is symmetric under wm → −wm.
 //
 // Samples: a MicrofacetSample with pdf == 0 is discarded (its direction left the side it must
-// be on, or the input was degenerate); its weight is 0. The weight f·|wi.z|/pdf of a kept sample
-// is G(wo, wi)/G1(wo), in [0, 1], for both BSDFs: the single-scattering model loses energy
-// (tests/microfacet_test.cpp records how much), which issue 42's multiple-scattering
-// compensation is to make up.
+// be on, or the input was degenerate); its weight is 0 and its wi the zero vector. The weight
+// f·|wi.z|/pdf of a kept sample is G(wo, wi)/G1(wo), in [0, 1], for both BSDFs: the
+// single-scattering model loses energy (tests/microfacet_test.cpp records how much), which issue
+// 42's multiple-scattering compensation is to make up.
 
 #include "nimbus/math/vec3.h"
 
@@ -25,8 +25,8 @@ inline constexpr double kMinMicrofacetAlpha = 1e-4;
 
 // GGX distribution of facet normals, normalised by ∫_{wm.z>0} D(wm) wm.z dwm = 1; even in wm.
 double ggx_d(double alpha, const Vec3& wm);
-// Smith's Λ for GGX: masking G1(w) = 1/(1 + Λ(w)); depends on |w.z| only through tan θ.
-// Infinite at grazing (w.z == 0).
+// Smith's Λ for GGX, a function of tan²θ, the same on both sides; masking G1 = 1/(1 + Λ).
+// Infinite at grazing (w.z == 0), where G1 = 0.
 double smith_lambda(double alpha, const Vec3& w);
 double smith_g1(double alpha, const Vec3& w);
 // Height-correlated masking-shadowing 1/(1 + Λ(wo) + Λ(wi)) (Heitz 2014).
@@ -55,16 +55,17 @@ struct MicrofacetSample {
 // the zero vector when wi = −wo.
 Vec3 reflection_half_vector(const Vec3& wo, const Vec3& wi);
 
-// Rough conductor, reflection only: f = D(wm) G(wo, wi) / (4 |wo.z| |wi.z|), 0 unless wi is on
-// wo's side; the caller multiplies by fresnel_conductor(|wo·wm|, ...) per channel, with
-// wm = reflection_half_vector(wo, wi). Reciprocal: f(wo, wi) = f(wi, wo).
+// Rough conductor, reflection only, wo on either side: f = D(wm) G(wo, wi) / (4 |wo.z| |wi.z|),
+// 0 unless wi is on wo's side; the caller multiplies by fresnel_conductor(|wo·wm|, ...) per
+// channel, with wm = reflection_half_vector(wo, wi). Reciprocal: f(wo, wi) = f(wi, wo).
 double conductor_microfacet(double alpha, const Vec3& wo, const Vec3& wi);
 double conductor_microfacet_pdf(double alpha, const Vec3& wo, const Vec3& wi);
 // wi reflects wo about a visible normal; pdf = D_wo(wm) / (4 |wo·wm|).
 MicrofacetSample sample_conductor_microfacet(double alpha, const Vec3& wo, double u1, double u2);
 
 // Rough dielectric (Walter et al. 2007) between the outside (+z side) and the inside (−z side),
-// eta = n_inside / n_outside (not 1: a matched interface is no boundary); wo on either side.
+// eta = n_inside / n_outside > 0 (not 1: a matched interface is no boundary, and refraction
+// through it has no density); wo on either side.
 // f includes the Fresnel factors and, like render/material.h's smooth dielectric, no 1/η²
 // radiance factor (the path carries L/n², equal to L where camera and lights are, in n = 1).
 // With n(w) the index on w's side, f(wo, wi) / n(wi)² = f(wi, wo) / n(wo)²; reflection is
@@ -72,7 +73,7 @@ MicrofacetSample sample_conductor_microfacet(double alpha, const Vec3& wo, doubl
 double dielectric_microfacet(double alpha, double eta, const Vec3& wo, const Vec3& wi);
 double dielectric_microfacet_pdf(double alpha, double eta, const Vec3& wo, const Vec3& wi);
 // Samples a visible normal, then reflects with probability F(wo·wm) (total internal reflection:
-// F = 1), else refracts; the weight excludes nothing.
+// F = 1), else refracts; the weight includes the Fresnel factors.
 MicrofacetSample sample_dielectric_microfacet(double alpha, double eta, const Vec3& wo,
                                               double u_choice, double u1, double u2);
 
