@@ -15,6 +15,7 @@
 #include "nimbus/render/renderer.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
+#include "support/film_blocks.h"
 
 namespace nimbus {
 namespace {
@@ -105,18 +106,7 @@ TEST(EmitterSampling, EmissiveBallLightsLikeASphereLight) {
         render(compile_scene(load_scene_text(text(true, spectrum), "a")), options);
     const RenderResult b =
         render(compile_scene(load_scene_text(text(false, spectrum), "b")), options);
-    for (int by = 0; by < 16; by += 8)
-      for (int bx = 0; bx < 16; bx += 8) {
-        std::vector<int> pixels;
-        for (int y = by; y < by + 8; ++y)
-          for (int x = bx; x < bx + 8; ++x) pixels.push_back(y * 16 + x);
-        const MeanEstimate ma = region_mean(a.film, pixels), mb = region_mean(b.film, pixels);
-        for (int c = 0; c < 3; ++c) {
-          const double se = std::hypot(ma.standard_error[c], mb.standard_error[c]);
-          EXPECT_NEAR(ma.mean[c], mb.mean[c], 4 * se + 1e-12)
-              << spectrum << " block (" << bx << ", " << by << ") channel " << c;
-        }
-      }
+    test::expect_blocks_agree(a.film, b.film, 16, spectrum);
   }
 }
 

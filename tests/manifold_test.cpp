@@ -17,9 +17,13 @@
 #include "nimbus/render/renderer.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
+#include "support/film_blocks.h"
 
 namespace nimbus {
 namespace {
+
+using test::block_pixels;
+using test::expect_blocks_agree;
 
 Scene scene_from(const std::string& text, const std::vector<std::string>& overrides = {}) {
   return compile_scene(load_scene_text(text, "manifold_test", overrides));
@@ -199,33 +203,6 @@ TEST(ManifoldWalk, DegenerateBoundaryFailsCleanly) {
     for (int c = 0; c < 3; ++c) EXPECT_TRUE(std::isfinite(r.film.mean(p)[c])) << p;
 }
 
-// The pixels of the 8 x 8 block whose corner is (bx, by) in a size x size film.
-std::vector<int> block_pixels(int bx, int by, int size) {
-  std::vector<int> pixels;
-  for (int y = by; y < by + 8; ++y)
-    for (int x = bx; x < bx + 8; ++x) pixels.push_back(y * size + x);
-  return pixels;
-}
-
-// Whether two films agree per 8 x 8 block within 4 standard errors of the difference of their
-// means (the blocks' variances from the per-pixel sample variances; independent samples).
-void expect_blocks_agree(const Film& a, const Film& b, int size, const char* what) {
-  ASSERT_EQ(size % 8, 0);
-  int compared = 0;
-  for (int by = 0; by < size; by += 8)
-    for (int bx = 0; bx < size; bx += 8) {
-      const std::vector<int> pixels = block_pixels(bx, by, size);
-      const MeanEstimate ma = region_mean(a, pixels), mb = region_mean(b, pixels);
-      for (int c = 0; c < 3; ++c) {
-        const double se = std::hypot(ma.standard_error[c], mb.standard_error[c]);
-        EXPECT_NEAR(ma.mean[c], mb.mean[c], 4 * se + 1e-12)
-            << what << ": block (" << bx << ", " << by << ") channel " << c << ", SE " << se;
-        ++compared;
-      }
-    }
-  EXPECT_EQ(compared, size * size / 64 * 3);
-}
-
 RenderResult render_with(const std::string& text, bool manifold,
                          std::vector<std::string> overrides = {}) {
   RenderOptions options;
@@ -235,13 +212,13 @@ RenderResult render_with(const std::string& text, bool manifold,
 }
 
 // Where both apply (a sphere light of finite size), manifold sampling and BSDF or phase sampling
-// alone estimate the same image; the partition keeps them from counting a path twice.
+// alone estimate the same image; MIS keeps them from counting a path twice.
 void expect_same_image_on_and_off(const std::string& text, int size, const char* what,
                                   const std::vector<std::string>& overrides = {}) {
   const RenderResult on = render_with(text, true, overrides),
                      off = render_with(text, false, overrides);
   EXPECT_GT(on.counters.manifold.found, 0u) << what;
-  EXPECT_GT(on.counters.manifold.checks, 0u) << what;  // the partition decided some light hits
+  EXPECT_GT(on.counters.manifold.checks, 0u) << what;  // MIS weighed some light hits
   EXPECT_EQ(off.counters.manifold.walks, 0u) << what;
   expect_blocks_agree(on.film, off.film, size, what);
 }
