@@ -27,8 +27,9 @@ class FirstVertexRecorder {
     if (pending_) record_medium(scene, ray, t, inside);
   }
 
-  // An object's surface at distance t, of outward normal n: a diffuse surface's reflectance, an
-  // emissive surface's 0, the normal facing the ray; a dielectric is passed through.
+  // An object's surface at distance t, of outward normal n: a diffuse surface's reflectance, a
+  // conductor's at normal incidence, an emissive surface's 0, the normal facing the ray; a
+  // dielectric is passed through.
   void surface(const Surface& s, const Ray& ray, double t, const Vec3& n) {
     if (!pending_) return;
     const Vec3 facing = dot(ray.d, n) < 0 ? n : -n;
@@ -38,7 +39,10 @@ class FirstVertexRecorder {
       return;
     }
     camera_ray_ends(t);
-    set(s.type == Surface::Type::Diffuse ? s.albedo.rgb : Rgb(0.0), facing);
+    set(s.type == Surface::Type::Diffuse     ? s.albedo.rgb
+        : s.type == Surface::Type::Conductor ? conductor_reflectance(s)
+                                             : Rgb(0.0),
+        facing);
     pending_ = false;
   }
 

@@ -17,6 +17,7 @@
 #include "nimbus/media/medium_field.h"
 #include "nimbus/render/counters.h"
 #include "nimbus/render/first_vertex.h"
+#include "nimbus/render/glossy.h"
 #include "nimbus/render/light_choice.h"
 #include "nimbus/render/manifold_light.h"
 #include "nimbus/render/mirror_light.h"
@@ -44,13 +45,12 @@ struct LightCandidate {
 template <int N, class F>
 std::optional<LightCandidate<N>> light_candidate(const Scene& scene, const PathSpectra<N>& ps,
                                                  int light_index, const LightSample& ls,
-                                                 const Vec3& p, const Vec3& n, bool on_surface,
-                                                 F&& f) {
-  if (on_surface && dot(ls.wi, n) <= 0) return std::nullopt;
+                                                 const ChainStart& at, F&& f) {
+  if (at.on_surface && at.boundary < 0 && dot(ls.wi, at.n) <= 0) return std::nullopt;
   const Spectrum<N> fv = f(ls.wi);
   if (fv.is_black()) return std::nullopt;
   return LightCandidate<N>{ls, fv, light_emission(ps, scene, light_index) * ls.falloff,
-                           on_surface ? offset_origin(scene, p, n, ls.wi) : p};
+                           at.on_surface ? offset_origin(scene, at.p, at.n, ls.wi) : at.p};
 }
 
 // The light slots of a bounce's sampler dimensions (SampleDims::bounce): one per light, or with
@@ -120,7 +120,7 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Cha
         return;
       }
     }
-    auto cand = light_candidate(scene, ps, i, *sampled, at.p, at.n, at.on_surface, f);
+    auto cand = light_candidate(scene, ps, i, *sampled, at, f);
     if (!cand) return;
     LightSample& ls = cand->ls;
     // The light technique's pdf includes the pick; a delta light's weight has no pdf to carry it.
@@ -130,9 +130,9 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Cha
       ls.pdf *= choice_pdf;
     Spectrum<N> term;
     sampler.first_from(dims + SampleDims::kShadow);
-    const bool lit =
-        policy.light_term(scene, ps, {cand->origin, ls.wi}, ls.distance * kShadowShrink, i,
-                          at.inside, ls, cand->f * cand->Li, f_pdf, sampler.rng(), counters, term);
+    const bool lit = policy.light_term(scene, ps, {cand->origin, ls.wi},
+                                       ls.distance * kShadowShrink, i, side_of(at, ls.wi), ls,
+                                       cand->f * cand->Li, f_pdf, sampler.rng(), counters, term);
     sampler.done();
     if (lit) L += term;
   };
@@ -176,12 +176,13 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Cha
           L += manifold_term<N>(scene, ps, at, *shape, target, seed, {-1, object}, emitted,
                                 q / emitters, policy, f, f_pdf, rng, counters);
       }
-    } else if (e && at.inside < 0) {
+    } else if (e) {
       const Vec3 to = e->y - at.p;
       const double d = length(to);
       const Vec3 wi = to / d;
       const double cos_y = dot(e->n, -wi);
-      if (cos_y > 0 && d > 0 && !(at.on_surface && dot(wi, at.n) <= 0)) {
+      if (cos_y > 0 && d > 0 && side_of(at, wi) < 0 &&
+          !(at.on_surface && at.boundary < 0 && dot(wi, at.n) <= 0)) {
         const Spectrum<N> fv = f(wi);
         LightSample ls{wi, d, 1.0, e->pdf_area * d * d / cos_y / emitters, false};
         // The shadow ray runs from its own origin to just short of the point: the emitter
@@ -190,7 +191,7 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Cha
         const double t = length(e->y - o);
         Spectrum<N> term;
         if (!fv.is_black() && ls.pdf > 0 && std::isfinite(ls.pdf) &&
-            policy.light_term(scene, ps, {o, (e->y - o) / t}, t * kShadowShrink, -1, at.inside, ls,
+            policy.light_term(scene, ps, {o, (e->y - o) / t}, t * kShadowShrink, -1, -1, ls,
                               fv * Le, f_pdf, rng, counters, term))
           L += term;
       }
@@ -352,6 +353,41 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
       emitters_sampled = inside < 0;
       chain = ChainRecord::leaving(at, wi, manifold);
       ray = {offset_origin(scene, p, ns, wi), wi};
+    } else if (obj.surface.roughness > 0) {
+      // A rough conductor or dielectric (render/glossy.h): next-event estimation with MIS, to
+      // both sides of a dielectric boundary (the shadow ray in the medium of its side), then a
+      // direction sampled from the microfacet lobe. Manifold sampling does not start here.
+      const Vec3 wo = -ray.d;
+      const bool two_sided = obj.surface.type == Surface::Type::Dielectric;
+      const ChainStart at{p, two_sided || dot(wo, n) > 0 ? n : -n, true, inside,
+                          two_sided ? hit->object : -1};
+      const Glossy<N> g(obj.surface, ps, at.n);
+      L += policy.throughput() *
+           direct_light(
+               scene, ps, at, depth, false, policy,
+               [&](const Vec3& wi) { return g.f(wo, wi) * std::abs(dot(wi, n)); },
+               [&](const Vec3& wi) { return g.pdf(wo, wi); }, sampler, bounce, counters);
+      const std::array<double, 2> u = sampler.get2d(bounce + SampleDims::kDirection);
+      const auto gs = g.sample(wo, sampler.get1d(bounce + SampleDims::kChoice), u[0], u[1]);
+      if (!gs) break;
+      policy.scattered(gs->weight, gs->pdf);
+      prev_p = p;
+      light_sampled = true;
+      emitters_sampled = side_of(at, gs->wi) < 0;
+      chain = ChainRecord::leaving(at, gs->wi, false);
+      if (two_sided) inside = side_of(at, gs->wi);
+      ray = {offset_origin(scene, p, n, gs->wi), gs->wi};
+    } else if (obj.surface.type == Surface::Type::Conductor) {
+      // A smooth conductor: the mirror direction, weighted by its Fresnel reflectance.
+      const Vec3 nf = dot(ray.d, n) < 0 ? n : -n;
+      const Vec3 wi = ray.d - nf * (2 * dot(ray.d, nf));
+      policy.scattered(conductor_fresnel(evaluate(obj.surface.eta, ps.ch),
+                                         evaluate(obj.surface.k, ps.ch), -dot(ray.d, nf)),
+                       1.0);
+      light_sampled = false;
+      emitters_sampled = false;
+      chain.specular(hit->object, true);
+      ray = {offset_origin(scene, p, nf, wi), wi};
     } else {
       const DielectricSample ds = sample_dielectric(-ray.d, n, obj.surface.ior,
                                                     sampler.get1d(bounce + SampleDims::kChoice));

@@ -164,7 +164,7 @@ bool derivative(const Scene& scene, const ChainStart& start, const ChainShape& s
 
 bool has_dielectric_solid(const Scene& scene) {
   return std::any_of(scene.objects.begin(), scene.objects.end(), [](const SceneObject& o) {
-    return o.surface.type == Surface::Type::Dielectric;
+    return smooth_dielectric(o.surface);
   });
 }
 
@@ -183,8 +183,7 @@ std::optional<ChainShape> chain_shape(const Scene& scene, const ChainStart& star
   if (start.inside >= 0)
     return hit->object == start.inside ? std::optional<ChainShape>({start.inside, 1, hit->t})
                                        : std::nullopt;
-  if (scene.objects[size_t(hit->object)].surface.type != Surface::Type::Dielectric)
-    return std::nullopt;
+  if (!smooth_dielectric(scene.objects[size_t(hit->object)].surface)) return std::nullopt;
   return ChainShape{hit->object, 2, hit->t};
 }
 

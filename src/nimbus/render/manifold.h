@@ -19,13 +19,23 @@
 namespace nimbus {
 
 // The vertex a chain leaves from: a medium point, or a diffuse surface point with the normal on
-// the side the path is on. `inside`: the solid the vertex is in, or -1.
+// the side the path is on. `inside`: the solid the vertex is in, or -1. `boundary`: for a point
+// on a rough dielectric boundary, which scatters to both sides, that solid (n is then its outward
+// normal); -1 elsewhere. Manifold sampling does not start from such points.
 struct ChainStart {
   Vec3 p;
   Vec3 n;
   bool on_surface = false;
   int inside = -1;
+  int boundary = -1;
 };
+
+// The solid a ray leaving `at` in direction w is in: across a rough dielectric boundary, the solid
+// on w's side of it (one level: the space around a solid is outside every solid).
+inline int side_of(const ChainStart& at, const Vec3& w) {
+  if (at.boundary < 0) return at.inside;
+  return dot(w, at.n) < 0 ? at.boundary : (at.inside == at.boundary ? -1 : at.inside);
+}
 
 // A point on a light (point lights, sphere lights), or a direction towards one at infinity.
 struct ChainTarget {

@@ -4,6 +4,15 @@
 
 namespace nimbus {
 
+Rgb conductor_reflectance(const Surface& s) {
+  Rgb r(0.0);
+  for (int c = 0; c < 3; ++c) {
+    const double eta = s.eta.rgb[c], k2 = s.k.rgb[c] * s.k.rgb[c];
+    r[c] = ((eta - 1) * (eta - 1) + k2) / ((eta + 1) * (eta + 1) + k2);
+  }
+  return r;
+}
+
 double fresnel_dielectric(double cos_i, double eta) {
   const double sin2_t = (1 - cos_i * cos_i) / (eta * eta);
   if (sin2_t >= 1) return 1.0;  // total internal reflection

@@ -1,6 +1,7 @@
 #pragma once
-// Surface scattering: opaque Lambertian, smooth lossless dielectric, emitter. Directions are
-// unit vectors; wo points away from the surface towards where the path came from.
+// Surface scattering: opaque Lambertian, lossless dielectric and conductor, smooth or rough
+// (render/microfacet.h), emitter. Directions are unit vectors; wo points away from the surface
+// towards where the path came from.
 
 #include "nimbus/math/vec3.h"
 #include "nimbus/spectral/spectral_param.h"
@@ -8,12 +9,23 @@
 namespace nimbus {
 
 struct Surface {
-  enum class Type { None, Diffuse, Dielectric, Emissive };
+  enum class Type { None, Diffuse, Dielectric, Emissive, Conductor };
   Type type = Type::Diffuse;
   SpectralParam albedo{Rgb(0.5)};  // role Albedo
   double ior = 1.5;
   SpectralParam radiance;  // role Illuminant
+  double roughness = 0;    // dielectric, conductor: GGX α; 0 is the smooth (delta) case
+  SpectralParam eta{Rgb(1.0)}, k{Rgb(0.0)};  // conductor: complex index η + ik, role Unbounded
 };
+
+// A dielectric whose boundary is smooth: what manifold sampling looks through.
+inline bool smooth_dielectric(const Surface& s) {
+  return s.type == Surface::Type::Dielectric && s.roughness == 0;
+}
+
+// The conductor's reflectance at normal incidence, ((η − 1)² + k²) / ((η + 1)² + k²), per RGB
+// channel: its colour for the albedo AOV and the preview.
+Rgb conductor_reflectance(const Surface& s);
 
 // Unpolarised Fresnel reflectance at a smooth interface; eta = n_transmitted / n_incident.
 double fresnel_dielectric(double cos_i, double eta);

@@ -228,6 +228,8 @@ void complete_spectra(Scene& scene) {
   for (SceneObject& obj : scene.objects) {
     complete_spectrum(obj.surface.albedo, SpectralRole::Albedo);
     complete_spectrum(obj.surface.radiance, SpectralRole::Illuminant);
+    complete_spectrum(obj.surface.eta, SpectralRole::Unbounded);
+    complete_spectrum(obj.surface.k, SpectralRole::Unbounded);
   }
   for (Light& l : scene.lights) complete_spectrum(l.emission, SpectralRole::Illuminant);
 }

@@ -35,6 +35,9 @@ Surface compile_surface(const SurfaceDesc& d) {
   s.albedo = d.albedo;
   s.ior = d.ior;
   s.radiance = d.radiance;
+  s.roughness = d.roughness;
+  s.eta = d.eta;
+  s.k = d.k;
   return s;
 }
 

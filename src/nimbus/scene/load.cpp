@@ -31,7 +31,8 @@ namespace {
 constexpr double kMinDeterminant = 1e-12;
 
 // In the order of SurfaceDesc::Type, so that an index is the enumerator.
-const std::vector<std::string_view> kSurfaceTypes = {"none", "diffuse", "dielectric", "emissive"};
+const std::vector<std::string_view> kSurfaceTypes = {"none", "diffuse", "dielectric", "emissive",
+                                                     "conductor"};
 
 }  // namespace
 
@@ -374,6 +375,12 @@ class Loader {
           break;
         case SurfaceDesc::Type::Dielectric:
           if (auto i = so.optional("ior")) obj.surface.ior = i->number(at_least(1));
+          if (auto r = so.optional("roughness")) obj.surface.roughness = r->number(between(0, 1));
+          break;
+        case SurfaceDesc::Type::Conductor:
+          obj.surface.eta = read_colour(so.required("eta"), SpectralRole::Unbounded, above(0));
+          obj.surface.k = read_colour(so.required("k"), SpectralRole::Unbounded, at_least(0));
+          if (auto r = so.optional("roughness")) obj.surface.roughness = r->number(between(0, 1));
           break;
         case SurfaceDesc::Type::Emissive:
           obj.surface.radiance =

@@ -57,9 +57,11 @@ struct MediumDesc {
 struct SurfaceDesc {
   using Type = Surface::Type;
   Type type = Type::Diffuse;
-  SpectralParam albedo{Rgb(0.5)};  // diffuse
-  double ior = 1.5;                // dielectric
-  SpectralParam radiance;          // emissive
+  SpectralParam albedo{Rgb(0.5)};            // diffuse
+  double ior = 1.5;                          // dielectric
+  SpectralParam radiance;                    // emissive
+  double roughness = 0;                      // dielectric, conductor
+  SpectralParam eta{Rgb(1.0)}, k{Rgb(0.0)};  // conductor
 };
 
 struct ObjectDesc {

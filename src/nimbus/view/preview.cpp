@@ -21,6 +21,8 @@ Rgb surface_colour(const Scene& scene, const SceneObject& object, double cos_eye
       return object.surface.radiance.rgb;
     case Surface::Type::Diffuse:
       return object.surface.albedo.rgb * shade;
+    case Surface::Type::Conductor:
+      return conductor_reflectance(object.surface) * shade;
     case Surface::Type::Dielectric: {
       if (object.medium < 0) return Rgb(0.9) * shade;
       const Medium& m = scene.media[size_t(object.medium)];
