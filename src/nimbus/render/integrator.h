@@ -361,7 +361,7 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
       const bool two_sided = obj.surface.type == Surface::Type::Dielectric;
       const ChainStart at{p, two_sided || dot(wo, n) > 0 ? n : -n, true, inside,
                           two_sided ? hit->object : -1};
-      const Glossy<N> g(obj.surface, ps, at.n);
+      const Glossy<N> g(obj.surface, ps, at.n, obj.albedo.get());
       L += policy.throughput() *
            direct_light(
                scene, ps, at, depth, false, policy,

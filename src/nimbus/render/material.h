@@ -15,6 +15,7 @@ struct Surface {
   double ior = 1.5;
   SpectralParam radiance;  // role Illuminant
   double roughness = 0;    // dielectric, conductor: GGX α; 0 is the smooth (delta) case
+  bool multiple_scattering = true;  // rough: give back the energy single scattering loses
   SpectralParam eta{Rgb(1.0)}, k{Rgb(0.0)};  // conductor: complex index η + ik, role Unbounded
 };
 

@@ -2,6 +2,7 @@
 // The compiled scene: flat, immutable, shared read-only by every thread.
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -71,10 +72,15 @@ struct RenderSettings {
   AovSet aovs = {};  // the layers written beside the colour (render/aov.h)
 };
 
+struct MicrofacetAlbedo;
+
 struct SceneObject {
   Tape tape;
   Box bounds;  // finite, conservative
   Surface surface;
+  // A rough surface's albedo tables for its multiple-scattering lobe (render/microfacet_albedo.h);
+  // null for others and where surface.multiple_scattering is off. Copies of an object share it.
+  std::shared_ptr<const MicrofacetAlbedo> albedo;
   int medium = -1;
   // The index of the description's object it comes from (one of its instances), or -1 for an
   // object built in code.

@@ -8,7 +8,10 @@
 #include <atomic>
 #include <cmath>
 #include <exception>
+#include <map>
+#include <memory>
 #include <stdexcept>
+#include <tuple>
 
 #include "nimbus/frep/bounds.h"
 #include "nimbus/media/build_monitor.h"
@@ -16,6 +19,7 @@
 #include "nimbus/media/octree.h"
 #include "nimbus/render/emitter.h"
 #include "nimbus/render/manifold.h"
+#include "nimbus/render/microfacet_albedo.h"
 #include "nimbus/scene/load.h"
 #include "nimbus/spectral/wavelengths.h"
 
@@ -36,9 +40,23 @@ Surface compile_surface(const SurfaceDesc& d) {
   s.ior = d.ior;
   s.radiance = d.radiance;
   s.roughness = d.roughness;
+  s.multiple_scattering = d.multiple_scattering;
   s.eta = d.eta;
   s.k = d.k;
   return s;
+}
+
+// The albedo tables of the rough surfaces that compensate multiple scattering, one per distinct
+// surface (copies of an object, and objects alike, share one).
+void tabulate_microfacet_albedo(Scene& scene) {
+  std::map<std::tuple<int, double, double>, std::shared_ptr<const MicrofacetAlbedo>> made;
+  for (SceneObject& obj : scene.objects) {
+    const Surface& s = obj.surface;
+    if (!(s.roughness > 0) || !s.multiple_scattering) continue;
+    auto& table = made[{static_cast<int>(s.type), s.roughness, s.ior}];
+    if (!table) table = std::make_shared<const MicrofacetAlbedo>(microfacet_albedo(s));
+    obj.albedo = table;
+  }
 }
 
 Medium compile_medium(const MediumDesc& d, std::vector<InputFile>& inputs) {
@@ -275,6 +293,7 @@ void finish_scene(Scene& scene, const BuildMonitor& monitor) {
   if (!all.empty()) scene.scale = length(all.extent());
   scene.surfaces = build_surface_index(scene.objects, scene.lights);
   complete_spectra(scene);
+  tabulate_microfacet_albedo(scene);
   scene.light_tree = build_light_tree(scene.lights);  // after the spectra: powers read bin_max
   scene.dielectric_solids = has_dielectric_solid(scene);
   scene.emitters = emissive_objects(scene);

@@ -376,11 +376,15 @@ class Loader {
         case SurfaceDesc::Type::Dielectric:
           if (auto i = so.optional("ior")) obj.surface.ior = i->number(at_least(1));
           if (auto r = so.optional("roughness")) obj.surface.roughness = r->number(between(0, 1));
+          if (auto m = so.optional("multiple_scattering"))
+            obj.surface.multiple_scattering = m->boolean();
           break;
         case SurfaceDesc::Type::Conductor:
           obj.surface.eta = read_colour(so.required("eta"), SpectralRole::Unbounded, above(0));
           obj.surface.k = read_colour(so.required("k"), SpectralRole::Unbounded, at_least(0));
           if (auto r = so.optional("roughness")) obj.surface.roughness = r->number(between(0, 1));
+          if (auto m = so.optional("multiple_scattering"))
+            obj.surface.multiple_scattering = m->boolean();
           break;
         case SurfaceDesc::Type::Emissive:
           obj.surface.radiance =

@@ -61,6 +61,7 @@ struct SurfaceDesc {
   double ior = 1.5;                          // dielectric
   SpectralParam radiance;                    // emissive
   double roughness = 0;                      // dielectric, conductor
+  bool multiple_scattering = true;           // dielectric, conductor
   SpectralParam eta{Rgb(1.0)}, k{Rgb(0.0)};  // conductor
 };
 
