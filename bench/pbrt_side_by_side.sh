@@ -17,7 +17,7 @@
 #             the generated grids, cached references (refs/), images (tmp/)
 # Options (passed to the driver): --spp N (64), --ref-spp N (4096), --reps N (5),
 #   --ref-threads N (all cores), --voxel-size H (1/64), --json FILE; scenes: cloud, cloud-grid,
-#   marble, skin, marble-sun (default: all).
+#   marble, skin, marble-sun, rough-marble, rough-gold (default: all).
 #   --manifold-off (off by default): also run nimbus with manifold next-event estimation off
 #   (--set integrator.manifold=false, rgb and spectral 4, spectral MIS) on every scene run. That
 #   render setting comes with issue 41; a nimbus without it rejects the key and the run stops.

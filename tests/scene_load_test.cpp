@@ -321,6 +321,16 @@ std::vector<BadScene> bad_scenes() {
        with_object(R"({"shape": )" + ball + R"(, "surface": {"type": "conductor", "eta": 0.2}})"),
        {},
        "scene.json: /objects/0/surface/k: required key is missing"},
+      {"unknown metal",
+       with_object(R"({"shape": )" + ball +
+                   R"(, "surface": {"type": "conductor", "metal": "brass"}})"),
+       {},
+       R"(scene.json: /objects/0/surface/metal: unknown metal "brass" (expected one of: aluminium, copper, gold, silver))"},
+      {"metal and eta both",
+       with_object(R"({"shape": )" + ball +
+                   R"(, "surface": {"type": "conductor", "metal": "gold", "eta": 0.2}})"),
+       {},
+       R"(scene.json: /objects/0/surface/eta: give either "metal" or "eta" and "k", not both)"},
       {"roughness on a diffuse surface",
        with_object(R"({"shape": )" + ball + R"(, "surface": {"roughness": 0.2}})"),
        {},

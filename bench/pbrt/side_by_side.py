@@ -74,6 +74,10 @@ SCENES = {
     "skin": ("skin ellipsoid (SSS behind glass, IOR 1.3)", "skin.json", "skin.pbrt"),
     "marble-sun": ("marble sphere under a 1° sun (sphere light)", "marble_sun.json",
                    "marble_sun.pbrt"),
+    "rough-marble": ("marble sphere behind a rough dielectric (GGX α 0.3, single scattering)",
+                     "rough_marble.json", "rough_marble.pbrt"),
+    "rough-gold": ("rough gold-like conductor sphere (GGX α 0.2, single scattering)",
+                   "rough_gold.json", "rough_gold.pbrt"),
 }
 
 
@@ -139,7 +143,8 @@ def stage(ctx):
     for f in ("chromatic_cloud.json", "marble.json", "skin.json", "marble_sun.json"):
         shutil.copyfile(os.path.join(REPO, "scenes", "bench", f), os.path.join(out, f))
     for f in ("chromatic_cloud_vdb.json", "chromatic_cloud.pbrt", "marble.pbrt", "skin.pbrt",
-              "marble_sun.pbrt"):
+              "marble_sun.pbrt", "rough_marble.json", "rough_marble.pbrt", "rough_gold.json",
+              "rough_gold.pbrt"):
         shutil.copyfile(os.path.join(HERE, f), os.path.join(out, f))
     src = os.path.join(out, "chromatic_cloud.json")
     stamp = os.path.join(out, "chromatic_cloud.grid-stamp")

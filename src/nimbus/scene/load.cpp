@@ -22,6 +22,7 @@
 #include "nimbus/scene/emission_grid.h"
 #include "nimbus/scene/instances_file.h"
 #include "nimbus/scene/light_types.h"
+#include "nimbus/spectral/metals.h"
 
 namespace nimbus {
 namespace {
@@ -380,8 +381,17 @@ class Loader {
             obj.surface.multiple_scattering = m->boolean();
           break;
         case SurfaceDesc::Type::Conductor:
-          obj.surface.eta = read_colour(so.required("eta"), SpectralRole::Unbounded, above(0));
-          obj.surface.k = read_colour(so.required("k"), SpectralRole::Unbounded, at_least(0));
+          if (auto m = so.optional("metal")) {
+            const auto metal = metal_by_name(metal_names()[m->choice("metal", metal_names())]);
+            for (const char* key : {"eta", "k"})
+              if (auto v = so.optional(key))
+                v->fail(R"(give either "metal" or "eta" and "k", not both)");
+            obj.surface.eta = metal->eta;
+            obj.surface.k = metal->k;
+          } else {
+            obj.surface.eta = read_colour(so.required("eta"), SpectralRole::Unbounded, above(0));
+            obj.surface.k = read_colour(so.required("k"), SpectralRole::Unbounded, at_least(0));
+          }
           if (auto r = so.optional("roughness")) obj.surface.roughness = r->number(between(0, 1));
           if (auto m = so.optional("multiple_scattering"))
             obj.surface.multiple_scattering = m->boolean();
