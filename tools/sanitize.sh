@@ -25,6 +25,9 @@ repeats+=':Modes/SpectralRender.EmittingField*:Modes/SpectralRender.SingleScatte
 repeats+=':Modes/SpectralRender.EmissiveFurnace*'
 repeats+=':Modes/MediaRender.EmissiveFurnaceIsInEquilibrium/*Unbounded*'
 repeats+=':ManyMedia.OverlappingCopiesRenderAsTheirSum'
+repeats+=':RayMarchingTransmittance.MatchesAnalyticTransmittance'
+repeats+=':ManifoldRender.NarrowingConesTendToTheDirectionalLight'
+repeats+=':ManifoldRender.ShrinkingSphereLightsTendToThePointLight'
 filter="*:-$repeats"
 [ "${1:-}" = "--all" ] && filter='*'
 sanitized_tests() {
