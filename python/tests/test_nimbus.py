@@ -411,3 +411,25 @@ def test_threads_rendering_one_scene_with_other_seeds_get_their_own_bits():
     assert not errors
     for seed in (11, 12):
         assert np.array_equal(results[seed], nimbus.render(scene, spp=2, seed=seed))
+
+
+def test_rough_metals_and_their_errors_through_a_dict():
+    """Issue 42's surface keys from Python: a rough named metal renders as its file does, and a
+    bad key is the loader's one line."""
+    document = {
+        "film": {"width": 8, "height": 8},
+        "camera": {"from": [0, 0, 4], "to": [0, 0, 0], "fov": 30},
+        "lights": [{"type": "environment", "radiance": 1}],
+        "objects": [{"shape": {"type": "sphere", "radius": 1},
+                     "surface": {"type": "conductor", "metal": "gold", "roughness": 0.3}}],
+    }
+    image = nimbus.render(nimbus.load_dict(document), spp=4)
+    assert np.isfinite(image).all()
+    centre = image[3:5, 3:5].mean(axis=(0, 1))
+    assert centre[0] > centre[2]  # gold reflects more red than blue
+    document["objects"][0]["surface"]["metal"] = "brass"
+    with pytest.raises(nimbus.SceneError, match=r'/objects/0/surface/metal: unknown metal "brass"'):
+        nimbus.load_dict(document)
+    document["objects"][0]["surface"] = {"type": "dielectric", "roughness": 2}
+    with pytest.raises(nimbus.SceneError, match=r"/objects/0/surface/roughness: must be in \[0, 1\]"):
+        nimbus.load_dict(document)
