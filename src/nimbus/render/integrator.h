@@ -164,11 +164,8 @@ Spectrum<N> direct_light(const Scene& scene, const PathSpectra<N>& ps, const Cha
       if (depth + shape->vertices < scene.settings.max_depth &&
           walks_to_area(scene, shape->vertices) && may_arrive_in_front(scene, *shape, *e)) {
         const ChainSeed seed = seed_chain(scene, at, target, *shape);
-        const Box& b = scene.objects[size_t(object)].bounds;
-        const double q =
-            walk_probability(scene, ps, at, *shape, seed) *
-            (shape->vertices == 2 ? caustic_walk_share(at.p, b.center(), 0.5 * length(b.extent()))
-                                  : 1.0);
+        const double q = walk_probability(scene, ps, at, *shape, seed) *
+                         (shape->vertices == 2 ? emitter_walk_share(scene, object, at.p) : 1.0);
         const auto emitted = [&](const SpecularChain& c) {
           return surface_chain_emission(Le, *e, c);
         };

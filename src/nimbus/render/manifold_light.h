@@ -31,7 +31,8 @@
 
 namespace nimbus {
 
-// What a path did since it left its last diffuse or medium vertex, for the MIS weights of its light hits.
+// What a path did since it left its last diffuse or medium vertex, for the MIS weights of its light
+// hits.
 struct ChainRecord {
   ChainStart start;
   Vec3 dir0;       // the direction it left in
@@ -108,6 +109,12 @@ inline double caustic_walk_share(const Vec3& p, const Vec3& center, double radiu
   const double d2 = dot(to, to), r2 = radius * radius;
   const double omega = d2 > r2 ? 2 * kPi * (1 - std::sqrt(1 - r2 / d2)) : 4 * kPi;
   return std::min(1.0, kCausticSolidAngle / omega);
+}
+
+// The same for the emissive surface of `object`, whose bounding sphere is its bounds'.
+inline double emitter_walk_share(const Scene& scene, int object, const Vec3& p) {
+  const Box& b = scene.objects[size_t(object)].bounds;
+  return caustic_walk_share(p, b.center(), 0.5 * length(b.extent()));
 }
 
 // What a chain ends on: a light (point, sphere, directional), or an emissive surface.
@@ -319,10 +326,8 @@ double manifold_surface_pdf(const Scene& scene, const PathSpectra<N>& ps, const 
   if (!walks_to_emitters(scene) || !manifold_detail::walkable(scene, chain)) return 0;
   const double pdf_area = emitter_point_pdf(scene, object, y, n);
   if (!(pdf_area > 0)) return 0;
-  const Box& b = scene.objects[size_t(object)].bounds;
   const auto found = manifold_detail::walk_finds(
-      scene, ps, chain, y, caustic_walk_share(chain.start.p, b.center(), 0.5 * length(b.extent())),
-      counters);
+      scene, ps, chain, y, emitter_walk_share(scene, object, chain.start.p), counters);
   if (!found) return 0;
   const double cos_y = dot(n, -found->chain.dir_out);
   if (!(cos_y > 0)) return 0;
