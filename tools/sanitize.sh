@@ -28,6 +28,8 @@ repeats+=':ManyMedia.OverlappingCopiesRenderAsTheirSum'
 repeats+=':RayMarchingTransmittance.MatchesAnalyticTransmittance'
 repeats+=':ManifoldRender.NarrowingConesTendToTheDirectionalLight'
 repeats+=':ManifoldRender.ShrinkingSphereLightsTendToThePointLight'
+repeats+=':Modes/MediaRender.WhiteFurnaceCloudDensityIndexMatched/*Unbounded*'
+repeats+=':Modes/MediaRender.*/*Depth12'
 filter="*:-$repeats"
 [ "${1:-}" = "--all" ] && filter='*'
 sanitized_tests() {
