@@ -31,7 +31,9 @@ set(NIMBUS_PUBLIC_HEADERS
     media/member_grid.h
     media/noise.h
     media/octree.h
+    media/pattern_density.h
     media/temperature_emission.h
+    media/texture.h
     media/vdb_density.h
     nimbus.h
     render/aov.h

@@ -435,9 +435,11 @@ py::tuple media_at(const PyScene& scene, const Rows& points) {
     const Scene& sc = *compiled;
     tbb::parallel_for(size_t{0}, p.size(), [&](size_t i) {
       Rgb mu_a(0.0), mu_s(0.0);
-      for_each_medium_at(sc, p[i], solid_containing(sc, p[i]), [&](int m, double density) {
-        mu_a += sc.media[size_t(m)].sigma_a.rgb * density;
-        mu_s += sc.media[size_t(m)].sigma_s.rgb * density;
+      const Vec3 x = p[i];
+      for_each_medium_at(sc, x, solid_containing(sc, x), [&](int m, double density, double F) {
+        const Medium& med = sc.media[size_t(m)];
+        mu_a += textured_rgb(med.sigma_a, med.sigma_a_to, med.sigma_a_texture, x, F) * density;
+        mu_s += textured_rgb(med.sigma_s, med.sigma_s_to, med.sigma_s_texture, x, F) * density;
       });
       for (int c = 0; c < 3; ++c) {
         a[3 * i + c] = mu_a[c];

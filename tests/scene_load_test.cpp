@@ -331,6 +331,66 @@ std::vector<BadScene> bad_scenes() {
                    R"(, "surface": {"type": "conductor", "metal": "gold", "eta": 0.2}})"),
        {},
        R"(scene.json: /objects/0/surface/eta: give either "metal" or "eta" and "k", not both)"},
+      {"textured roughness of 0",
+       with_object(
+           R"({"shape": )" + ball +
+           R"(, "surface": {"type": "dielectric", "roughness": {"texture": {"type": "noise"}, "from": 0, "to": 0.5}}})"),
+       {},
+       "scene.json: /objects/0/surface/roughness/from: a textured roughness must be > 0 (0 is the "
+       "smooth boundary, which a texture cannot blend into)"},
+      {"textured roughness above 1",
+       with_object(
+           R"({"shape": )" + ball +
+           R"(, "surface": {"type": "conductor", "metal": "gold", "roughness": {"texture": {"type": "veins"}, "from": 0.1, "to": 2}}})"),
+       {},
+       "scene.json: /objects/0/surface/roughness/to: must be in [0, 1]"},
+      {"texture on the ior",
+       with_object(
+           R"({"shape": )" + ball +
+           R"(, "surface": {"type": "dielectric", "ior": {"texture": {"type": "noise"}, "from": 1.3, "to": 1.6}}})"),
+       {},
+       "scene.json: /objects/0/surface/ior: takes no texture (textures drive a diffuse albedo, a "
+       "roughness, and a medium's sigma_a and sigma_s)"},
+      {"texture on an emissive radiance",
+       with_object(
+           R"({"shape": )" + ball +
+           R"(, "surface": {"type": "emissive", "radiance": {"texture": {"type": "noise"}, "from": 0, "to": 1}}})"),
+       {},
+       "scene.json: /objects/0/surface/radiance: takes no texture (textures drive a diffuse "
+       "albedo, "
+       "a roughness, and a medium's sigma_a and sigma_s)"},
+      {"textured albedo without its to",
+       with_object(R"({"shape": )" + ball +
+                   R"(, "surface": {"albedo": {"texture": {"type": "turbulence"}, "from": 0.2}}})"),
+       {},
+       "scene.json: /objects/0/surface/albedo/to: required key is missing"},
+      {"textured albedo above 1",
+       with_object(
+           R"({"shape": )" + ball +
+           R"(, "surface": {"albedo": {"texture": {"type": "noise"}, "from": 0.2, "to": [1, 1.5, 1]}}})"),
+       {},
+       "scene.json: /objects/0/surface/albedo/to/1: must be in [0, 1]"},
+      {"textured sigma with an unknown texture type",
+       with_medium(R"({"sigma_a": {"texture": {"type": "marble"}, "from": 0, "to": 1}})"),
+       {},
+       R"(scene.json: /media/cloud/sigma_a/texture/type: unknown density type "marble" (expected one of: constant, field, cloud, vdb, noise, turbulence, veins))"},
+      {"textured sigma with a negative end",
+       with_medium(R"({"sigma_s": {"texture": {"type": "noise"}, "from": 1, "to": [1, -2, 3]}})"),
+       {},
+       "scene.json: /media/cloud/sigma_s/to/1: must be >= 0"},
+      {"texture key of another pattern",
+       with_medium(
+           R"({"sigma_s": {"texture": {"type": "noise", "sharpness": 3}, "from": 1, "to": 2}})"),
+       {},
+       R"(scene.json: /media/cloud/sigma_s/texture/sharpness: unknown key for density type "noise")"},
+      {"veins of sharpness below 1",
+       with_medium(R"({"density": {"type": "veins", "sharpness": 0.5}})"),
+       {},
+       "scene.json: /media/cloud/density/sharpness: must be in [1, 1000]"},
+      {"textured value with a stray key",
+       with_medium(R"({"sigma_s": {"texture": {"type": "noise"}, "from": 1, "to": 2, "by": 3}})"),
+       {},
+       R"(scene.json: /media/cloud/sigma_s/by: unknown key for a textured value (expected "texture", "from" and "to"))"},
       {"roughness on a diffuse surface",
        with_object(R"({"shape": )" + ball + R"(, "surface": {"roughness": 0.2}})"),
        {},

@@ -405,7 +405,7 @@ TEST(VdbDensity, BadInputIsOneLineNamingTheJsonPathAndTheFile) {
        scene + "/file: a file name cannot hold a NUL byte"},
       {R"({"type": "voxels"})",
        scene +
-           R"(/type: unknown density type "voxels" (expected one of: constant, field, cloud, vdb))"},
+           R"(/type: unknown density type "voxels" (expected one of: constant, field, cloud, vdb, noise, turbulence, veins))"},
       {R"({"type": "vdb"})", scene + "/file: required key is missing"},
       // A misspelt key is reported before the file is read with the default grid.
       {R"({"type": "vdb", "file": "nowhere.vdb", "gird": "x"})",

@@ -24,6 +24,7 @@
 #include "nimbus/media/constant_density.h"
 #include "nimbus/media/field_density.h"
 #include "nimbus/media/octree.h"
+#include "nimbus/media/pattern_density.h"
 #include "nimbus/media/temperature_emission.h"
 #include "nimbus/media/vdb_density.h"
 #include "nimbus/render/film.h"

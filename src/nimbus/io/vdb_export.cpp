@@ -98,6 +98,13 @@ VdbExportResult export_vdb(const Scene& scene, int object, double h, const std::
   const SceneObject& obj = scene.objects.at(object);
   if (obj.medium < 0) throw std::invalid_argument(fmt::format("object {} holds no medium", object));
   const Medium& medium = scene.media[obj.medium];
+  // One density grid with constant coefficients beside it cannot hold coefficients that vary
+  // apart from the density.
+  if (medium.sigma_a_texture || medium.sigma_s_texture)
+    throw std::invalid_argument(fmt::format(
+        "object {}: its medium's sigma_a or sigma_s is textured; an export holds one density grid "
+        "and constant coefficients",
+        object));
   const double voxels = vdb_export_voxels(scene, object, h);
   if (!(voxels <= kVdbExportMaxVoxels))
     throw std::invalid_argument(fmt::format(

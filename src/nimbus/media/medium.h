@@ -9,6 +9,7 @@
 #include "nimbus/media/constant_density.h"
 #include "nimbus/media/density.h"
 #include "nimbus/media/temperature_emission.h"
+#include "nimbus/media/texture.h"
 #include "nimbus/spectral/spectral_param.h"
 #include "nimbus/spectral/spectrum.h"
 
@@ -16,18 +17,32 @@ namespace nimbus {
 
 struct Medium {
   SpectralParam sigma_a, sigma_s;  // coefficients (role Unbounded)
-  SpectralParam emission;          // L_e, entering the RTE as mu_a L_e (eq. 4) (role Illuminant)
-  double g = 0;                    // Henyey–Greenstein asymmetry; 0 is isotropic
+  // Solid textures (media/texture.h): set, sigma_a (sigma_s) is the coefficient where t = 0 and
+  // sigma_a_to (sigma_s_to) where t = 1, before the density.
+  Texture sigma_a_texture, sigma_s_texture;
+  SpectralParam sigma_a_to, sigma_s_to;
+  SpectralParam emission;  // L_e, entering the RTE as mu_a L_e (eq. 4) (role Illuminant)
+  double g = 0;            // Henyey–Greenstein asymmetry; 0 is isotropic
   DensityPtr density = make_constant_density();
   double scale = 1;  // multiplies the density
   // Set: L_e at each point is this grid's, and `emission` is 0.
   std::shared_ptr<const TemperatureEmission> emission_grid;
 };
 
+// Whether the medium's density or textures read F, the holding object's function at the point.
+inline bool medium_uses_F(const Medium& m) {
+  return m.density->uses_F() || (m.sigma_a_texture && m.sigma_a_texture.pattern->uses_F()) ||
+         (m.sigma_s_texture && m.sigma_s_texture.pattern->uses_F());
+}
+
 // A medium's coefficients at a path's N channels (spectral/channels.h), before the density.
 template <int N>
 struct MediumCoefficients {
   Spectrum<N> sigma_a, sigma_s, emission;
+  // Textured coefficients (null: none): sigma_a + (sigma_a_to − sigma_a) t(x), and so for s.
+  const Texture* sigma_a_texture = nullptr;
+  const Texture* sigma_s_texture = nullptr;
+  Spectrum<N> sigma_a_to{0.0}, sigma_s_to{0.0};
   // Set (a temperature grid): L_e varies and is evaluated per point at the channels below;
   // `emission` is then 0. Null for every medium of constant emission, which costs a test.
   const TemperatureEmission* emission_grid = nullptr;

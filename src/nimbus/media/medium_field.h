@@ -50,7 +50,7 @@ struct MediumPoint {
 // The density (the factor on sigma_a, sigma_s) of `medium` at x, where its object's F is F.
 double medium_density(const Medium& medium, const Vec3& x, double F);
 
-// Calls f(medium index, density) for each medium present at x, seen from `inside`, the solid
+// Calls f(medium index, density, F) for each medium present at x, seen from `inside`, the solid
 // object the point is in (-1: none), in the order of the scene's field objects. In the field,
 // a scene with a member grid (member_grid.h) looks only at the objects listed for x's cell.
 template <MediumHolders S, class F>
@@ -59,16 +59,16 @@ void for_each_medium_at(const S& scene, const Vec3& x, int inside, F&& f) {
     const auto& obj = scene.objects[inside];
     if (obj.medium < 0) return;
     const Medium& medium = scene.media[obj.medium];
-    const double F_x = medium.density->uses_F() ? evaluate(obj.tape, x) : 1.0;
+    const double F_x = medium_uses_F(medium) ? evaluate(obj.tape, x) : 1.0;
     const double d = medium_density(medium, x, F_x);
-    if (d > 0) f(obj.medium, d);
+    if (d > 0) f(obj.medium, d, F_x);
     return;
   }
   // The medium of an object whose bounds hold x and whose F there is F_x.
   auto add = [&](int medium, double F_x) {
     if (F_x <= 0) return;
     const double d = medium_density(scene.media[medium], x, F_x);
-    if (d > 0) f(medium, d);
+    if (d > 0) f(medium, d, F_x);
   };
   auto visit = [&](int i) { add(scene.objects[i].medium, evaluate(scene.objects[i].tape, x)); };
   if constexpr (requires { scene.field_grid; }) {
@@ -115,18 +115,25 @@ void for_each_medium_at(const S& scene, const Vec3& x, int inside, F&& f) {
 
 namespace medium_field_detail {
 
-// Adds a medium of coefficients c at density `density` at x to the sums mu_a, mu_s and
-// mu_a_Le = Σ mu_a,i L_e,i.
+// Adds a medium of coefficients c at density `density` at x, where its object's F is F, to the
+// sums mu_a, mu_s and mu_a_Le = Σ mu_a,i L_e,i; returns the medium's own mu_s.
 template <int N>
-void add_medium(const MediumCoefficients<N>& c, double density, const Vec3& x, Spectrum<N>& mu_a,
-                Spectrum<N>& mu_s, Spectrum<N>& mu_a_Le) {
-  const Spectrum<N> a = c.sigma_a * density;
+Spectrum<N> add_medium(const MediumCoefficients<N>& c, double density, const Vec3& x, double F,
+                       Spectrum<N>& mu_a, Spectrum<N>& mu_s, Spectrum<N>& mu_a_Le) {
+  Spectrum<N> a = c.sigma_a, s = c.sigma_s;
+  if (c.sigma_a_texture) [[unlikely]]
+    a += (c.sigma_a_to - c.sigma_a) * c.sigma_a_texture->at(x, F);
+  if (c.sigma_s_texture) [[unlikely]]
+    s += (c.sigma_s_to - c.sigma_s) * c.sigma_s_texture->at(x, F);
+  a *= density;
+  s *= density;
   mu_a += a;
-  mu_s += c.sigma_s * density;
+  mu_s += s;
   if (c.emission_grid)
     mu_a_Le += a * temperature_emission_at<N>(*c.emission_grid, x, c.spectral, c.lambda);
   else
     mu_a_Le += a * c.emission;
+  return s;
 }
 
 }  // namespace medium_field_detail
@@ -140,9 +147,10 @@ void medium_at(const S& scene, const std::vector<MediumCoefficients<N>>& coeffic
                const Vec3& x, int inside, MediumPoint<N>& m) {
   m.mu_a = m.mu_s = m.mu_a_Le = Spectrum<N>(0.0);
   m.lobes = 0;
-  for_each_medium_at(scene, x, inside, [&](int medium, double density) {
+  for_each_medium_at(scene, x, inside, [&](int medium, double density, double F) {
     const MediumCoefficients<N>& c = coefficients[medium];
-    medium_field_detail::add_medium(c, density, x, m.mu_a, m.mu_s, m.mu_a_Le);
+    const Spectrum<N> mu_s_i =
+        medium_field_detail::add_medium(c, density, x, F, m.mu_a, m.mu_s, m.mu_a_Le);
     const double g = scene.media[medium].g;
     int lobe = 0;
     while (lobe < m.lobes && m.g[lobe] != g) ++lobe;
@@ -155,7 +163,7 @@ void medium_at(const S& scene, const std::vector<MediumCoefficients<N>>& coeffic
       m.mu_s_i[lobe] = Spectrum<N>(0.0);
       ++m.lobes;
     }
-    m.mu_s_i[lobe] += c.sigma_s * density;
+    m.mu_s_i[lobe] += mu_s_i;
   });
 }
 
@@ -174,8 +182,8 @@ void medium_sums_at(const S& scene, const std::vector<MediumCoefficients<N>>& co
                     const Vec3& x, int inside, Spectrum<N>& mu_a, Spectrum<N>& mu_s,
                     Spectrum<N>& mu_a_Le) {
   mu_a = mu_s = mu_a_Le = Spectrum<N>(0.0);
-  for_each_medium_at(scene, x, inside, [&](int medium, double density) {
-    medium_field_detail::add_medium(coefficients[medium], density, x, mu_a, mu_s, mu_a_Le);
+  for_each_medium_at(scene, x, inside, [&](int medium, double density, double F) {
+    medium_field_detail::add_medium(coefficients[medium], density, x, F, mu_a, mu_s, mu_a_Le);
   });
 }
 

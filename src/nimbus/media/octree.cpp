@@ -29,13 +29,24 @@ std::vector<std::vector<double>> sigma_t_bins(std::span<const Medium> media, boo
   for (const Medium& m : media) {
     std::vector<double> v(2 * bins);
     for (int b = 0; b < bins; ++b) {
-      if (!spectral) {
-        v[b] = v[bins + b] = m.sigma_a.rgb[b] + m.sigma_s.rgb[b];
-        continue;
-      }
-      const auto [lo, hi] = spectral_bin_wavelengths(b);  // bins == kSpectralBins here
-      const auto [a_lo, a_hi] = m.sigma_a.curve->range(lo, hi);
-      const auto [s_lo, s_hi] = m.sigma_s.curve->range(lo, hi);
+      // A textured coefficient lies between its two ends.
+      auto bounds = [&](const SpectralParam& from, const SpectralParam& to, const Texture& t) {
+        std::pair<double, double> r;
+        if (!spectral) {
+          r = {from.rgb[b], from.rgb[b]};
+          if (t) r = {std::min(r.first, to.rgb[b]), std::max(r.second, to.rgb[b])};
+          return r;
+        }
+        const auto [lo, hi] = spectral_bin_wavelengths(b);  // bins == kSpectralBins here
+        r = from.curve->range(lo, hi);
+        if (t) {
+          const auto [t_lo, t_hi] = to.curve->range(lo, hi);
+          r = {std::min(r.first, t_lo), std::max(r.second, t_hi)};
+        }
+        return r;
+      };
+      const auto [a_lo, a_hi] = bounds(m.sigma_a, m.sigma_a_to, m.sigma_a_texture);
+      const auto [s_lo, s_hi] = bounds(m.sigma_s, m.sigma_s_to, m.sigma_s_texture);
       v[b] = a_hi + s_hi;
       v[bins + b] = std::max(0.0, a_lo + s_lo);
     }
@@ -301,7 +312,7 @@ void sample_bounds(std::span<const Medium> media, std::span<const MemberObject> 
       Vec3 x;
       for (int k = 0; k < 3; ++k) x[k] = box.lo[k] + rng.uniform() * (box.hi[k] - box.lo[k]);
       std::fill(mu.begin(), mu.end(), 0.0);
-      for_each_medium_at(scene, x, inside, [&](int medium, double density) {
+      for_each_medium_at(scene, x, inside, [&](int medium, double density, double) {
         for (int b = 0; b < 2 * bins; ++b) mu[b] += density * sigma_t[medium][b];
       });
       for (int b = 0; b < bins; ++b) {

@@ -7,10 +7,13 @@ namespace nimbus {
 void FirstVertexRecorder::record_medium(const Scene& scene, const Ray& ray, double t, int inside) {
   camera_ray_ends(t);
   Rgb mu_s(0.0), mu_t(0.0);
-  for_each_medium_at(scene, ray.at(t), inside, [&](int m, double density) {
+  const Vec3 x = ray.at(t);
+  for_each_medium_at(scene, x, inside, [&](int m, double density, double F) {
     const Medium& medium = scene.media[size_t(m)];
-    mu_s += medium.sigma_s.rgb * density;
-    mu_t += (medium.sigma_a.rgb + medium.sigma_s.rgb) * density;
+    const Rgb s = textured_rgb(medium.sigma_s, medium.sigma_s_to, medium.sigma_s_texture, x, F);
+    const Rgb a = textured_rgb(medium.sigma_a, medium.sigma_a_to, medium.sigma_a_texture, x, F);
+    mu_s += s * density;
+    mu_t += (a + s) * density;
   });
   Rgb albedo(0.0);
   for (int c = 0; c < 3; ++c)

@@ -39,7 +39,8 @@ class FirstVertexRecorder {
       return;
     }
     camera_ray_ends(t);
-    set(s.type == Surface::Type::Diffuse     ? s.albedo.rgb
+    set(s.type == Surface::Type::Diffuse
+            ? textured_rgb(s.albedo, s.albedo_to, s.albedo_texture, ray.at(t), 0.0)
         : s.type == Surface::Type::Conductor ? conductor_reflectance(s)
                                              : Rgb(0.0),
         facing);

@@ -39,9 +39,11 @@ class Glossy {
   // n: the normal the BSDF's frame stands on, the outward one for a dielectric (its inside is
   // below) and the one on the path's side for a conductor. albedo: the surface's tables for the
   // multiple-scattering lobe (render/microfacet_albedo.h), or null for single scattering alone.
-  Glossy(const Surface& s, const PathSpectra<N>& ps, const Vec3& n, const MicrofacetAlbedo* albedo)
+  // alpha: the GGX roughness at the point (roughness_at, material.h).
+  Glossy(const Surface& s, double alpha, const PathSpectra<N>& ps, const Vec3& n,
+         const MicrofacetAlbedo* albedo)
       : conductor_(s.type == Surface::Type::Conductor),
-        alpha_(s.roughness),
+        alpha_(alpha),
         ior_(s.ior),
         n_(n),
         albedo_(albedo) {

@@ -334,7 +334,10 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
 
     if (obj.surface.type == Surface::Type::Diffuse) {
       const Vec3 ns = dot(ray.d, n) < 0 ? n : -n;  // facing the incoming ray
-      const Spectrum<N> albedo = evaluate(obj.surface.albedo, ps.ch);
+      Spectrum<N> albedo = evaluate(obj.surface.albedo, ps.ch);
+      if (obj.surface.albedo_texture) [[unlikely]]
+        albedo += (evaluate(obj.surface.albedo_to, ps.ch) - albedo) *
+                  obj.surface.albedo_texture.at(p, 0.0);
       const Spectrum<N> f = albedo * kInvPi;
       const ChainStart at{p, ns, true, inside};
       L += policy.throughput() * direct_light(
@@ -358,7 +361,10 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
       const bool two_sided = obj.surface.type == Surface::Type::Dielectric;
       const ChainStart at{p, two_sided || dot(wo, n) > 0 ? n : -n, true, inside,
                           two_sided ? hit->object : -1};
-      const Glossy<N> g(obj.surface, ps, at.n, obj.albedo.get());
+      const double alpha = roughness_at(obj.surface, p);
+      MicrofacetAlbedo blended;
+      const Glossy<N> g(obj.surface, alpha, ps, at.n,
+                        obj.albedo ? obj.albedo->at(alpha, blended) : nullptr);
       L += policy.throughput() *
            direct_light(
                scene, ps, at, depth, false, policy,

@@ -4,6 +4,7 @@
 // towards where the path came from.
 
 #include "nimbus/math/vec3.h"
+#include "nimbus/media/texture.h"
 #include "nimbus/spectral/spectral_param.h"
 
 namespace nimbus {
@@ -13,11 +14,23 @@ struct Surface {
   Type type = Type::Diffuse;
   SpectralParam albedo{Rgb(0.5)};  // role Albedo
   double ior = 1.5;
-  SpectralParam radiance;  // role Illuminant
-  double roughness = 0;    // dielectric, conductor: GGX α; 0 is the smooth (delta) case
+  SpectralParam radiance;           // role Illuminant
+  double roughness = 0;             // dielectric, conductor: GGX α; 0 is the smooth (delta) case
   bool multiple_scattering = true;  // rough: give back the energy single scattering loses
   SpectralParam eta{Rgb(1.0)}, k{Rgb(0.0)};  // conductor: complex index η + ik, role Unbounded
+  // Solid textures (media/texture.h): set, albedo and roughness are the values where t = 0 and
+  // albedo_to and roughness_to those where t = 1.
+  Texture albedo_texture, roughness_texture;
+  SpectralParam albedo_to{Rgb(0.5)};  // role Albedo
+  double roughness_to = 0;
 };
+
+// The rough boundary's GGX α at the surface point x (the texture's F there is 0).
+inline double roughness_at(const Surface& s, const Vec3& x) {
+  return s.roughness_texture
+             ? s.roughness + (s.roughness_to - s.roughness) * s.roughness_texture.at(x, 0.0)
+             : s.roughness;
+}
 
 // A dielectric whose boundary is smooth: what manifold sampling looks through.
 inline bool smooth_dielectric(const Surface& s) {

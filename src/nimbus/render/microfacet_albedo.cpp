@@ -60,4 +60,43 @@ MicrofacetAlbedo microfacet_albedo(const Surface& s) {
   return t;
 }
 
+MicrofacetAlbedoLevels microfacet_albedo_levels(const Surface& s) {
+  MicrofacetAlbedoLevels l;
+  l.alpha0 = l.alpha1 = s.roughness;
+  if (!s.roughness_texture || s.roughness_to == s.roughness) {
+    l.levels.push_back(microfacet_albedo(s));
+    return l;
+  }
+  l.alpha1 = s.roughness_to;
+  Surface at = s;
+  for (int i = 0; i < MicrofacetAlbedoLevels::kLevels; ++i) {
+    at.roughness = l.alpha0 + (l.alpha1 - l.alpha0) * i / (MicrofacetAlbedoLevels::kLevels - 1);
+    l.levels.push_back(microfacet_albedo(at));
+  }
+  return l;
+}
+
+namespace {
+
+AlbedoCurve blend(const AlbedoCurve& a, const AlbedoCurve& b, double w) {
+  AlbedoCurve c;
+  for (size_t i = 0; i < c.E.size(); ++i) c.E[i] = a.E[i] + w * (b.E[i] - a.E[i]);
+  c.average = a.average + w * (b.average - a.average);
+  c.reflected = a.reflected + w * (b.reflected - a.reflected);
+  return c;
+}
+
+}  // namespace
+
+const MicrofacetAlbedo* MicrofacetAlbedoLevels::at(double alpha, MicrofacetAlbedo& scratch) const {
+  if (levels.size() == 1) return &levels[0];
+  const double x =
+      std::clamp((alpha - alpha0) / (alpha1 - alpha0), 0.0, 1.0) * double(levels.size() - 1);
+  const size_t i = std::min(levels.size() - 2, static_cast<size_t>(x));
+  const double w = x - double(i);
+  scratch.outside = blend(levels[i].outside, levels[i + 1].outside, w);
+  scratch.inside = blend(levels[i].inside, levels[i + 1].inside, w);
+  return &scratch;
+}
+
 }  // namespace nimbus

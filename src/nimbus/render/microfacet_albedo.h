@@ -9,6 +9,7 @@
 // the table is the same in every run.
 
 #include <array>
+#include <vector>
 
 namespace nimbus {
 
@@ -33,5 +34,18 @@ struct MicrofacetAlbedo {
 
 // The tables of a rough conductor or dielectric (roughness > 0).
 MicrofacetAlbedo microfacet_albedo(const Surface& s);
+
+// A rough surface's tables over its roughnesses: one level for a fixed roughness; for a textured
+// one (Surface::roughness_texture), kLevels levels at roughnesses spaced evenly from its "from"
+// to its "to", blended linearly in α between them.
+struct MicrofacetAlbedoLevels {
+  static constexpr int kLevels = 9;
+  double alpha0 = 0, alpha1 = 0;
+  std::vector<MicrofacetAlbedo> levels;
+  // The tables at α: a level itself, or `scratch` filled with the blend of the two around α.
+  const MicrofacetAlbedo* at(double alpha, MicrofacetAlbedo& scratch) const;
+};
+
+MicrofacetAlbedoLevels microfacet_albedo_levels(const Surface& s);
 
 }  // namespace nimbus

@@ -49,12 +49,25 @@ void channel_majorant_factors(PathSpectra<N>& ps, const Scene& scene) {
     double f = 0;
     for (size_t m = 0; m < scene.media.size() && f < 1; ++m) {
       const Medium& med = scene.media[m];
-      if (med.sigma_a.bin_max.empty() || med.sigma_s.bin_max.empty()) {
+      if (med.sigma_a.bin_max.empty() || med.sigma_s.bin_max.empty() ||
+          (med.sigma_a_texture && med.sigma_a_to.bin_max.empty()) ||
+          (med.sigma_s_texture && med.sigma_s_to.bin_max.empty())) {
         f = 1;
         break;
       }
-      const double bound = med.sigma_a.bin_max[ps.ch.bin[i]] + med.sigma_s.bin_max[ps.ch.bin[i]];
-      if (bound > 0) f = std::max(f, (ps.media[m].sigma_a[i] + ps.media[m].sigma_s[i]) / bound);
+      // A textured coefficient at its larger end, over the larger of its ends' bounds.
+      const int bin = ps.ch.bin[i];
+      const MediumCoefficients<N>& c = ps.media[m];
+      double bound = med.sigma_a.bin_max[bin] + med.sigma_s.bin_max[bin];
+      double sigma_t = c.sigma_a[i] + c.sigma_s[i];
+      if (med.sigma_a_texture || med.sigma_s_texture) {
+        const bool a = bool(med.sigma_a_texture), s = bool(med.sigma_s_texture);
+        bound = std::max(med.sigma_a.bin_max[bin], a ? med.sigma_a_to.bin_max[bin] : 0.0) +
+                std::max(med.sigma_s.bin_max[bin], s ? med.sigma_s_to.bin_max[bin] : 0.0);
+        sigma_t = std::max(c.sigma_a[i], a ? c.sigma_a_to[i] : 0.0) +
+                  std::max(c.sigma_s[i], s ? c.sigma_s_to[i] : 0.0);
+      }
+      if (bound > 0) f = std::max(f, sigma_t / bound);
     }
     // A medium without extinction in the bin leaves its majorant 0 there anyway.
     ps.ch.majorant_factor[i] = f > 0 ? std::min(f, 1.0) : 1.0;
@@ -79,6 +92,10 @@ void prepare_path_spectra(PathSpectra<N>& ps, const Scene& scene, double u) {
     MediumCoefficients<N>& c = ps.media[m];
     c.sigma_a = evaluate(med.sigma_a, ps.ch);
     c.sigma_s = evaluate(med.sigma_s, ps.ch);
+    c.sigma_a_texture = med.sigma_a_texture ? &med.sigma_a_texture : nullptr;
+    c.sigma_s_texture = med.sigma_s_texture ? &med.sigma_s_texture : nullptr;
+    if (c.sigma_a_texture) c.sigma_a_to = evaluate(med.sigma_a_to, ps.ch);
+    if (c.sigma_s_texture) c.sigma_s_to = evaluate(med.sigma_s_to, ps.ch);
     c.emission = evaluate(med.emission, ps.ch);
     c.emission_grid = med.emission_grid.get();
     if (c.emission_grid) {

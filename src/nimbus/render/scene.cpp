@@ -223,10 +223,13 @@ void complete_spectra(Scene& scene) {
   for (Medium& m : scene.media) {
     complete_spectrum(m.sigma_a, SpectralRole::Unbounded);
     complete_spectrum(m.sigma_s, SpectralRole::Unbounded);
+    complete_spectrum(m.sigma_a_to, SpectralRole::Unbounded);
+    complete_spectrum(m.sigma_s_to, SpectralRole::Unbounded);
     complete_spectrum(m.emission, SpectralRole::Illuminant);
   }
   for (SceneObject& obj : scene.objects) {
     complete_spectrum(obj.surface.albedo, SpectralRole::Albedo);
+    complete_spectrum(obj.surface.albedo_to, SpectralRole::Albedo);
     complete_spectrum(obj.surface.radiance, SpectralRole::Illuminant);
     complete_spectrum(obj.surface.eta, SpectralRole::Unbounded);
     complete_spectrum(obj.surface.k, SpectralRole::Unbounded);

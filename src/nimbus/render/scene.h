@@ -72,7 +72,7 @@ struct RenderSettings {
   AovSet aovs = {};  // the layers written beside the colour (render/aov.h)
 };
 
-struct MicrofacetAlbedo;
+struct MicrofacetAlbedoLevels;
 
 struct SceneObject {
   Tape tape;
@@ -80,7 +80,7 @@ struct SceneObject {
   Surface surface;
   // A rough surface's albedo tables for its multiple-scattering lobe (render/microfacet_albedo.h);
   // null for others and where surface.multiple_scattering is off. Copies of an object share it.
-  std::shared_ptr<const MicrofacetAlbedo> albedo;
+  std::shared_ptr<const MicrofacetAlbedoLevels> albedo;
   int medium = -1;
   // The index of the description's object it comes from (one of its instances), or -1 for an
   // object built in code.

@@ -33,7 +33,22 @@ Camera compile_camera(const CameraDesc& c, const RenderSettings& film) {
 
 namespace {
 
-Surface compile_surface(const SurfaceDesc& d) {
+// A texture's pattern, made once for an object and its copies.
+Texture compile_texture(const TextureDesc& d, std::vector<InputFile>& inputs) {
+  Texture t;
+  if (d) {
+    t.pattern = d.make(inputs);
+    t.scale = d.scale;
+  }
+  return t;
+}
+
+// The surface's textures (albedo, roughness), made before its copies.
+struct SurfaceTextures {
+  Texture albedo, roughness;
+};
+
+Surface compile_surface(const SurfaceDesc& d, const SurfaceTextures& t) {
   Surface s;
   s.type = d.type;
   s.albedo = d.albedo;
@@ -43,18 +58,24 @@ Surface compile_surface(const SurfaceDesc& d) {
   s.multiple_scattering = d.multiple_scattering;
   s.eta = d.eta;
   s.k = d.k;
+  s.albedo_texture = t.albedo;
+  s.albedo_to = d.albedo_to;
+  s.roughness_texture = t.roughness;
+  s.roughness_to = d.roughness_to;
   return s;
 }
 
 // The albedo tables of the rough surfaces that compensate multiple scattering, one per distinct
 // surface (copies of an object, and objects alike, share one).
 void tabulate_microfacet_albedo(Scene& scene) {
-  std::map<std::tuple<int, double, double>, std::shared_ptr<const MicrofacetAlbedo>> made;
+  std::map<std::tuple<int, double, double, double>, std::shared_ptr<const MicrofacetAlbedoLevels>>
+      made;
   for (SceneObject& obj : scene.objects) {
     const Surface& s = obj.surface;
     if (!(s.roughness > 0) || !s.multiple_scattering) continue;
-    auto& table = made[{static_cast<int>(s.type), s.roughness, s.ior}];
-    if (!table) table = std::make_shared<const MicrofacetAlbedo>(microfacet_albedo(s));
+    const double to = s.roughness_texture ? s.roughness_to : s.roughness;
+    auto& table = made[{static_cast<int>(s.type), s.roughness, to, s.ior}];
+    if (!table) table = std::make_shared<const MicrofacetAlbedoLevels>(microfacet_albedo_levels(s));
     obj.albedo = table;
   }
 }
@@ -63,6 +84,10 @@ Medium compile_medium(const MediumDesc& d, std::vector<InputFile>& inputs) {
   Medium m;
   m.sigma_a = d.sigma_a;
   m.sigma_s = d.sigma_s;
+  m.sigma_a_texture = compile_texture(d.sigma_a_texture, inputs);
+  m.sigma_s_texture = compile_texture(d.sigma_s_texture, inputs);
+  m.sigma_a_to = d.sigma_a_to;
+  m.sigma_s_to = d.sigma_s_to;
   m.emission = d.emission;
   if (d.emission_grid) m.emission_grid = d.emission_grid(inputs);
   m.g = d.phase.type == PhaseDesc::Type::HenyeyGreenstein ? d.phase.g : 0.0;
@@ -77,13 +102,15 @@ Medium compile_medium(const MediumDesc& d, std::vector<InputFile>& inputs) {
 double optical_thickness_bound(const Scene& scene, const SceneObject& obj) {
   const Medium& m = scene.media[obj.medium];
   const Interval density = m.density->range(obj.bounds, evaluate(obj.tape, obj.bounds));
-  double sigma_t = 0;
-  if (scene.settings.spectral.mode == SpectralSettings::Mode::Spectral) {
-    sigma_t = m.sigma_a.curve->range(kLambdaMin, kLambdaMax).second +
-              m.sigma_s.curve->range(kLambdaMin, kLambdaMax).second;
-  } else {
-    sigma_t = (m.sigma_a.rgb + m.sigma_s.rgb).max_abs();
-  }
+  // A textured coefficient at the larger of its ends.
+  auto largest = [&](const SpectralParam& from, const SpectralParam& to, const Texture& t) {
+    if (scene.settings.spectral.mode != SpectralSettings::Mode::Spectral)
+      return t ? std::max(from.rgb.max_abs(), to.rgb.max_abs()) : from.rgb.max_abs();
+    const double a = from.curve->range(kLambdaMin, kLambdaMax).second;
+    return t ? std::max(a, to.curve->range(kLambdaMin, kLambdaMax).second) : a;
+  };
+  const double sigma_t = largest(m.sigma_a, m.sigma_a_to, m.sigma_a_texture) +
+                         largest(m.sigma_s, m.sigma_s_to, m.sigma_s_texture);
   return m.scale * density.hi * sigma_t * length(obj.bounds.extent());
 }
 
@@ -124,6 +151,11 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
   scene.camera = compile_camera(desc.camera, desc.settings);
 
   for (const MediumDesc& md : desc.media) scene.media.push_back(compile_medium(md, read));
+  std::vector<SurfaceTextures> textures(desc.objects.size());
+  for (size_t k = 0; k < desc.objects.size(); ++k) {
+    textures[k].albedo = compile_texture(desc.objects[k].surface.albedo_texture, read);
+    textures[k].roughness = compile_texture(desc.objects[k].surface.roughness_texture, read);
+  }
   if (inputs) {
     *inputs = desc.inputs;
     inputs->insert(inputs->end(), read.begin(), read.end());
@@ -212,7 +244,7 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
         continue;
       }
       obj.bounds = b.box;
-      obj.surface = compile_surface(od.surface);
+      obj.surface = compile_surface(od.surface, textures[k]);
       obj.medium = medium;
       obj.source = int(k);
       const double g = obj.medium >= 0 ? scene.media[obj.medium].g : 0;

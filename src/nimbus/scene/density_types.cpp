@@ -3,6 +3,7 @@
 #include "nimbus/media/cloud_density.h"
 #include "nimbus/media/constant_density.h"
 #include "nimbus/media/field_density.h"
+#include "nimbus/media/pattern_density.h"
 #include "nimbus/media/vdb_density.h"
 #include "nimbus/scene/load.h"
 
@@ -30,6 +31,35 @@ DensityMaker read_cloud(JsonObject& d) {
   return [p](std::vector<InputFile>&) { return make_cloud_density(p); };
 }
 
+// docs/scene-format.md, "Textures": the solid patterns' frequency, octaves and seed; veins also
+// their direction, turbulence, noise frequency and sharpness.
+DensityMaker read_pattern(JsonObject& d, PatternParams::Kind kind) {
+  PatternParams p;
+  p.kind = kind;
+  if (auto y = d.optional("frequency")) p.frequency = y->number(kLength);
+  if (auto y = d.optional("octaves")) p.octaves = y->integer(between(1, 16));
+  if (auto y = d.optional("seed")) p.seed = y->unsigned_integer();
+  if (kind == PatternParams::Kind::Veins) {
+    if (auto y = d.optional("direction")) p.direction = normalize(normalize(y->direction()));
+    if (auto y = d.optional("turbulence")) p.turbulence = y->number(between(0, 1e3));
+    if (auto y = d.optional("noise_frequency")) p.noise_frequency = y->number(kLength);
+    if (auto y = d.optional("sharpness")) p.sharpness = y->number(between(1, 1e3));
+  }
+  return [p](std::vector<InputFile>&) { return make_pattern_density(p); };
+}
+
+DensityMaker read_noise(JsonObject& d) {
+  return read_pattern(d, PatternParams::Kind::Noise);
+}
+
+DensityMaker read_turbulence(JsonObject& d) {
+  return read_pattern(d, PatternParams::Kind::Turbulence);
+}
+
+DensityMaker read_veins(JsonObject& d) {
+  return read_pattern(d, PatternParams::Kind::Veins);
+}
+
 // docs/scene-format.md: a grid of a .vdb or .nvdb file (relative to the scene file's folder), by
 // name, moved further by an optional transform. The file is read when the scene is compiled;
 // every problem with it is then one line naming the key at fault and the file.
@@ -54,10 +84,9 @@ DensityMaker read_vdb(JsonObject& d) {
 
 const std::vector<DensityType>& density_types() {
   static const std::vector<DensityType> types = {
-      {"constant", read_constant},
-      {"field", read_field},
-      {"cloud", read_cloud},
-      {"vdb", read_vdb},
+      {"constant", read_constant}, {"field", read_field}, {"cloud", read_cloud},
+      {"vdb", read_vdb},           {"noise", read_noise}, {"turbulence", read_turbulence},
+      {"veins", read_veins},
   };
   return types;
 }

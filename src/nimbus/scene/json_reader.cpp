@@ -146,6 +146,7 @@ void JsonValue::check(double x, const Range& range) const {
 }
 
 double JsonValue::number(const Range& range) const {
+  if (json_->is_object() && json_->contains("texture")) fail(kTakesNoTexture);
   if (!json_->is_number()) fail(fmt::format("expected a number, not {}", type_name(*json_)));
   const double x = json_->get<double>();
   if (!std::isfinite(x)) fail("must be finite");

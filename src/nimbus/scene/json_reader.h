@@ -51,6 +51,11 @@ struct JsonOrigin {
   std::string folder = "";
 };
 
+// What a value that holds a solid texture ({"texture": ...}) is told where its key takes none.
+inline constexpr std::string_view kTakesNoTexture =
+    "takes no texture (textures drive a diffuse albedo, a roughness, and a medium's sigma_a and "
+    "sigma_s)";
+
 // One JSON value and its JSON pointer ("" for the document itself).
 class JsonValue {
  public:

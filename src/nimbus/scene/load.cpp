@@ -39,6 +39,7 @@ const std::vector<std::string_view> kSurfaceTypes = {"none", "diffuse", "dielect
 
 SpectralParam read_colour(const JsonValue& v, SpectralRole role, const Range& range) {
   if (!v.json().is_object()) return SpectralParam(v.rgb(range));
+  if (v.json().contains("texture")) v.fail(kTakesNoTexture);
   JsonObject o(v);
   const auto spectrum = o.optional("spectrum");
   const auto blackbody = role == SpectralRole::Illuminant ? o.optional("blackbody") : std::nullopt;
@@ -299,14 +300,76 @@ class Loader {
     return l;
   }
 
+  // A density's object, or a texture's: "type" (default "constant"), "scale" and the type's own
+  // keys. `constant`: whether the type is "constant".
+  static Deferred<DensityPtr> read_density(const JsonValue& v, double& scale, bool& constant) {
+    JsonObject d(v);
+    std::string type = "constant";
+    if (auto t = d.optional("type")) type = string_choice(*t, "density type", density_type_names());
+    if (auto s = d.optional("scale")) scale = s->number(at_least(0));
+    Deferred<DensityPtr> made;
+    for (const DensityType& t : density_types())
+      if (t.name == type) made = t.read(d);
+    constant = type == "constant";
+    d.finish(fmt::format("for density type \"{}\"", type));
+    return made;
+  }
+
+  static bool is_textured(const JsonValue& v) {
+    return v.json().is_object() && v.json().contains("texture");
+  }
+
+  // {"texture": T, "from": a, "to": b}: T's pattern and scale; a and b are read by `value`.
+  template <class T, class Read>
+  static TextureDesc read_textured(const JsonValue& v, T& from, T& to, Read&& value) {
+    JsonObject o(v);
+    TextureDesc t;
+    bool constant = false;
+    t.make = read_density(o.required("texture"), t.scale, constant);
+    from = value(o.required("from"));
+    to = value(o.required("to"));
+    o.finish(R"(for a textured value (expected "texture", "from" and "to"))");
+    return t;
+  }
+
+  // A colour that a texture may drive.
+  static TextureDesc read_textured_colour(const JsonValue& v, SpectralParam& from,
+                                          SpectralParam& to, SpectralRole role,
+                                          const Range& range) {
+    auto colour = [&](const JsonValue& x) { return read_colour(x, role, range); };
+    if (!is_textured(v)) {
+      from = colour(v);
+      return {};
+    }
+    return read_textured(v, from, to, colour);
+  }
+
+  // A roughness, GGX α in [0, 1], that a texture may drive; a textured one is > 0 at both ends.
+  static TextureDesc read_roughness(const JsonValue& v, SurfaceDesc& s) {
+    if (!is_textured(v)) {
+      s.roughness = v.number(between(0, 1));
+      return {};
+    }
+    return read_textured(v, s.roughness, s.roughness_to, [](const JsonValue& x) {
+      const double a = x.number(between(0, 1));
+      if (a == 0)
+        x.fail(
+            "a textured roughness must be > 0 (0 is the smooth boundary, which a texture cannot "
+            "blend into)");
+      return a;
+    });
+  }
+
   static MediumDesc read_medium(const std::string& name, const JsonValue& v) {
     JsonObject o(v);
     MediumDesc m;
     m.name = name;
     if (auto x = o.optional("sigma_a"))
-      m.sigma_a = read_colour(*x, SpectralRole::Unbounded, at_least(0));
+      m.sigma_a_texture =
+          read_textured_colour(*x, m.sigma_a, m.sigma_a_to, SpectralRole::Unbounded, at_least(0));
     if (auto x = o.optional("sigma_s"))
-      m.sigma_s = read_colour(*x, SpectralRole::Unbounded, at_least(0));
+      m.sigma_s_texture =
+          read_textured_colour(*x, m.sigma_s, m.sigma_s_to, SpectralRole::Unbounded, at_least(0));
     if (auto x = o.optional("emission")) {
       if (is_emission_grid(*x))
         m.emission_grid = read_emission_grid(*x);
@@ -324,17 +387,8 @@ class Loader {
         if (auto g = p.optional("g")) m.phase.g = g->number(strictly_between(-1, 1));
       p.finish(fmt::format("for phase type \"{}\"", type));
     }
-    if (auto x = o.optional("density")) {
-      JsonObject d(*x);
-      std::string type = "constant";
-      if (auto t = d.optional("type"))
-        type = string_choice(*t, "density type", density_type_names());
-      if (auto s = d.optional("scale")) m.density_scale = s->number(at_least(0));
-      for (const DensityType& t : density_types())
-        if (t.name == type) m.density = t.read(d);
-      m.constant_density = type == "constant";
-      d.finish(fmt::format("for density type \"{}\"", type));
-    }
+    if (auto x = o.optional("density"))
+      m.density = read_density(*x, m.density_scale, m.constant_density);
     o.finish();
     return m;
   }
@@ -372,11 +426,13 @@ class Loader {
           break;
         case SurfaceDesc::Type::Diffuse:
           if (auto a = so.optional("albedo"))
-            obj.surface.albedo = read_colour(*a, SpectralRole::Albedo, between(0, 1));
+            obj.surface.albedo_texture = read_textured_colour(
+                *a, obj.surface.albedo, obj.surface.albedo_to, SpectralRole::Albedo, between(0, 1));
           break;
         case SurfaceDesc::Type::Dielectric:
           if (auto i = so.optional("ior")) obj.surface.ior = i->number(at_least(1));
-          if (auto r = so.optional("roughness")) obj.surface.roughness = r->number(between(0, 1));
+          if (auto r = so.optional("roughness"))
+            obj.surface.roughness_texture = read_roughness(*r, obj.surface);
           if (auto m = so.optional("multiple_scattering"))
             obj.surface.multiple_scattering = m->boolean();
           break;
@@ -392,7 +448,8 @@ class Loader {
             obj.surface.eta = read_colour(so.required("eta"), SpectralRole::Unbounded, above(0));
             obj.surface.k = read_colour(so.required("k"), SpectralRole::Unbounded, at_least(0));
           }
-          if (auto r = so.optional("roughness")) obj.surface.roughness = r->number(between(0, 1));
+          if (auto r = so.optional("roughness"))
+            obj.surface.roughness_texture = read_roughness(*r, obj.surface);
           if (auto m = so.optional("multiple_scattering"))
             obj.surface.multiple_scattering = m->boolean();
           break;

@@ -40,9 +40,22 @@ struct PhaseDesc {
   double g = 0;
 };
 
+// A parameter that a solid texture drives (docs/scene-format.md, "Textures"):
+// {"texture": T, "from": a, "to": b} is a + (b − a) · clamp(t(x), 0, 1). Unset: the parameter
+// is the plain value beside it ("from" then holds it).
+struct TextureDesc {
+  // How compile_scene makes the pattern, a density type's (scene/density_types.h); null: none.
+  Deferred<DensityPtr> make;
+  double scale = 1;
+  explicit operator bool() const { return bool(make); }
+};
+
 struct MediumDesc {
   std::string name;
   SpectralParam sigma_a, sigma_s, emission;
+  // Textured coefficients: sigma_a and sigma_s are then their "from" values.
+  TextureDesc sigma_a_texture, sigma_s_texture;
+  SpectralParam sigma_a_to, sigma_s_to;
   // Set: the emission is a temperature grid's (media/temperature_emission.h), read from its file
   // when the scene is compiled.
   Deferred<std::shared_ptr<const TemperatureEmission>> emission_grid;
@@ -63,6 +76,10 @@ struct SurfaceDesc {
   double roughness = 0;                      // dielectric, conductor
   bool multiple_scattering = true;           // dielectric, conductor
   SpectralParam eta{Rgb(1.0)}, k{Rgb(0.0)};  // conductor
+  // Textured albedo and roughness: albedo and roughness are then their "from" values.
+  TextureDesc albedo_texture, roughness_texture;
+  SpectralParam albedo_to;
+  double roughness_to = 0;
 };
 
 struct ObjectDesc {

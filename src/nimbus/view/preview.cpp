@@ -14,13 +14,15 @@ namespace {
 // What the eye sees at a surface: its colour under a light at the eye, with a floor so that
 // grazing faces stay visible. Dielectrics holding a medium show the medium's single-scattering
 // albedo, the colour they take on once light has wandered inside.
-Rgb surface_colour(const Scene& scene, const SceneObject& object, double cos_eye) {
+Rgb surface_colour(const Scene& scene, const SceneObject& object, const Vec3& x, double cos_eye) {
   const double shade = 0.2 + 0.8 * std::abs(cos_eye);
   switch (object.surface.type) {
     case Surface::Type::Emissive:
       return object.surface.radiance.rgb;
     case Surface::Type::Diffuse:
-      return object.surface.albedo.rgb * shade;
+      return textured_rgb(object.surface.albedo, object.surface.albedo_to,
+                          object.surface.albedo_texture, x, 0.0) *
+             shade;
     case Surface::Type::Conductor:
       return conductor_reflectance(object.surface) * shade;
     case Surface::Type::Dielectric: {
@@ -81,8 +83,9 @@ Image render_preview(const Scene& scene, const PreviewOptions& options) {
           L = scene.lights[size_t(hit->light)].emission.rgb;
         } else {
           const SceneObject& object = scene.objects[size_t(hit->object)];
-          const Vec3 n = outward_normal(object, ray.at(hit->t));
-          L = surface_colour(scene, object, dot(n, ray.d));
+          const Vec3 x = ray.at(hit->t);
+          const Vec3 n = outward_normal(object, x);
+          L = surface_colour(scene, object, x, dot(n, ray.d));
         }
       }
       // The media in front of it, marched at the steps' midpoints: transmittance T, and per
@@ -94,11 +97,14 @@ Image render_preview(const Scene& scene, const PreviewOptions& options) {
         for (int i = 0; i < steps; ++i) {
           const Vec3 p = ray.at(t0 + (i + 0.5) * dt);
           Rgb mu_a(0.0), mu_s(0.0), emitted(0.0);
-          for_each_medium_at(scene, p, -1, [&](int m, double density) {
+          for_each_medium_at(scene, p, -1, [&](int m, double density, double F) {
             const Medium& medium = scene.media[size_t(m)];
-            mu_a += medium.sigma_a.rgb * density;
-            mu_s += medium.sigma_s.rgb * density;
-            emitted += medium.sigma_a.rgb * medium.emission.rgb * density;
+            const Rgb a =
+                textured_rgb(medium.sigma_a, medium.sigma_a_to, medium.sigma_a_texture, p, F);
+            mu_a += a * density;
+            mu_s += textured_rgb(medium.sigma_s, medium.sigma_s_to, medium.sigma_s_texture, p, F) *
+                    density;
+            emitted += a * medium.emission.rgb * density;
           });
           Rgb step_T(0.0);
           for (int c = 0; c < 3; ++c) step_T[c] = std::exp(-(mu_a[c] + mu_s[c]) * dt);
