@@ -9,11 +9,8 @@ source tools/phase.sh
 phase "set-up" bash tools/setup.sh
 phase "Release configure" bash tools/configure.sh release
 phase "Release build" cmake --build build -j"$(nproc)"
-# The scripted tests under ctest, the GoogleTest binary in shards (tools/gtest_shards.sh): one
-# process start per shard rather than per test. `ctest --test-dir build` runs each test alone.
-release_tests() {
-  ctest --test-dir build --output-on-failure -j"$(nproc)" -LE gtest
-  bash tools/gtest_shards.sh build/nimbus_tests "$(nproc)" 16
-}
+# The scripted tests under ctest beside the GoogleTest binary in shards (tools/phase.sh):
+# `ctest --test-dir build` runs each test alone.
+release_tests() { suites build '*'; }
 phase "Release tests" release_tests
 bash tools/sanitize.sh "$@"
