@@ -208,19 +208,66 @@ TEST(TextureRender, TexturedAbsorberTransmitsTheExponentOfItsIntegral) {
 // under a sky of radiance 1 and nothing else: every pixel is 1 (a white furnace), in every
 // tracking mode, and its majorants bound it.
 TEST(TextureRender, TexturedWhiteMediumIsInvisibleInAFurnace) {
-  for (const char* tracking : {"delta", "spectral-history", "spectral-mis"}) {
-    SCOPED_TRACE(tracking);
-    const RenderResult r = render_text(fmt::format(R"({{"film": {{"width": 8, "height": 8}},
+  auto furnace = [](const char* tracking, double sigma_a) {
+    return render_text(fmt::format(R"({{"film": {{"width": 8, "height": 8}},
   "camera": {{"type": "orthographic", "from": [0, 0, 5], "to": [0, 0, 0], "width": 2}},
   "integrator": {{"spp": 32, "seed": 5, "tracking": "{}", "max_depth": 100000}},
   "lights": [{{"type": "environment", "radiance": 1}}],
   "shapes": {{"ball": {{"type": "sphere", "radius": 0.9}}}},
-  "media": {{"m": {{"sigma_a": 0, "sigma_s": {{"texture": {{"type": "noise", "frequency": 3}},
+  "media": {{"m": {{"sigma_a": {}, "sigma_s": {{"texture": {{"type": "noise", "frequency": 3}},
                                               "from": 0.5, "to": [8, 6, 4]}}}}}},
   "objects": [{{"shape": "ball", "medium": "m", "surface": {{"type": "none"}}}}]}})",
-                                                   tracking));
-    const test::Chi2 chi2 = test::film_chi2(r.film, [](int) { return Rgb(1.0); });
+                                   tracking, sigma_a));
+  };
+  auto sky = [](int) { return Rgb(1.0); };
+  for (const char* tracking : {"delta", "spectral-history", "spectral-mis"}) {
+    SCOPED_TRACE(tracking);
+    const RenderResult r = furnace(tracking, 0);
+    const test::Chi2 chi2 = test::film_chi2(r.film, sky);
     EXPECT_TRUE(chi2.passes()) << "chi2 " << chi2.value << " over " << chi2.dof;
+    EXPECT_EQ(r.counters.tracking.raised, 0u);
+    EXPECT_EQ(r.counters.tracking.clamped, 0u);
+    // Power: a medium that absorbs (sigma_a 0.3) fails.
+    EXPECT_FALSE(test::film_chi2(furnace(tracking, 0.3).film, sky).passes());
+  }
+}
+
+// The same furnace in spectral mode, sigma_s a spectrum at each end that the texture blends, its
+// ends crossing over the visible range: the image is the sky's alone, rendered apart (image
+// means within 4 standard errors of their difference in every channel; 4 sampled wavelengths
+// leave the sky itself a colour noise of about 1 %), and the octree's bins and the channels'
+// majorant factors bound the blend: no majorant is raised. A medium that absorbs (sigma_a 0.3)
+// fails the same comparison.
+TEST(TextureRender, TexturedChromaticMediumIsInvisibleInASpectralFurnace) {
+  auto scene = [](const char* tracking, const char* object, double sigma_a) {
+    return fmt::format(R"({{"film": {{"width": 16, "height": 16}},
+  "camera": {{"type": "orthographic", "from": [0, 0, 5], "to": [0, 0, 0], "width": 2}},
+  "integrator": {{"spp": 32, "seed": 6, "tracking": "{}", "max_depth": 100000}},
+  "spectrum": {{"mode": "spectral", "wavelengths": 4}},
+  "lights": [{{"type": "environment", "radiance": 1}}],
+  "shapes": {{"ball": {{"type": "sphere", "radius": 0.9}}}},
+  "media": {{"m": {{"sigma_a": {}, "sigma_s": {{
+      "texture": {{"type": "veins", "frequency": 1.5, "sharpness": 2}},
+      "from": {{"spectrum": [[400, 1], [700, 6]]}}, "to": {{"spectrum": [[400, 9], [700, 0.5]]}}}}}}}},
+  "objects": [{}]}})",
+                       tracking, sigma_a, object);
+  };
+  const char* ball = R"({"shape": "ball", "medium": "m", "surface": {"type": "none"}})";
+  // Whether two renders' image means agree within 4 standard errors in every channel.
+  auto agree = [](const RenderResult& a, const RenderResult& b) {
+    const MeanEstimate ma = image_mean(a.film), mb = image_mean(b.film);
+    bool same = true;
+    for (int c = 0; c < 3; ++c)
+      same = same && std::abs(ma.mean[c] - mb.mean[c]) <=
+                         4 * std::hypot(ma.standard_error[c], mb.standard_error[c]);
+    return same;
+  };
+  for (const char* tracking : {"spectral-history", "spectral-mis"}) {
+    SCOPED_TRACE(tracking);
+    const RenderResult sky = render_text(scene(tracking, "", 0));
+    const RenderResult r = render_text(scene(tracking, ball, 0));
+    EXPECT_TRUE(agree(r, sky));
+    EXPECT_FALSE(agree(render_text(scene(tracking, ball, 0.3)), sky));
     EXPECT_EQ(r.counters.tracking.raised, 0u);
     EXPECT_EQ(r.counters.tracking.clamped, 0u);
   }

@@ -13,7 +13,8 @@ namespace {
 
 // What the eye sees at a surface: its colour under a light at the eye, with a floor so that
 // grazing faces stay visible. Dielectrics holding a medium show the medium's single-scattering
-// albedo, the colour they take on once light has wandered inside.
+// albedo at the point seen (x, for textures), the colour they take on once light has wandered
+// inside.
 Rgb surface_colour(const Scene& scene, const SceneObject& object, const Vec3& x, double cos_eye) {
   const double shade = 0.2 + 0.8 * std::abs(cos_eye);
   switch (object.surface.type) {
@@ -28,9 +29,10 @@ Rgb surface_colour(const Scene& scene, const SceneObject& object, const Vec3& x,
     case Surface::Type::Dielectric: {
       if (object.medium < 0) return Rgb(0.9) * shade;
       const Medium& m = scene.media[size_t(object.medium)];
-      const Rgb mu_t = m.sigma_a.rgb + m.sigma_s.rgb;
+      const Rgb sigma_s = textured_rgb(m.sigma_s, m.sigma_s_to, m.sigma_s_texture, x, 0.0);
+      const Rgb mu_t = textured_rgb(m.sigma_a, m.sigma_a_to, m.sigma_a_texture, x, 0.0) + sigma_s;
       Rgb albedo(0.0);
-      for (int c = 0; c < 3; ++c) albedo[c] = mu_t[c] > 0 ? m.sigma_s.rgb[c] / mu_t[c] : 0.0;
+      for (int c = 0; c < 3; ++c) albedo[c] = mu_t[c] > 0 ? sigma_s[c] / mu_t[c] : 0.0;
       return albedo * shade;
     }
     case Surface::Type::None:
