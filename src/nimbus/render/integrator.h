@@ -362,7 +362,7 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
       const ChainStart at{p, two_sided || dot(wo, n) > 0 ? n : -n, true, inside,
                           two_sided ? hit->object : -1};
       const double alpha = roughness_at(obj.surface, p);
-      MicrofacetAlbedo blended;
+      std::optional<MicrofacetAlbedo> blended;
       const Glossy<N> g(obj.surface, alpha, ps, at.n,
                         obj.albedo ? obj.albedo->at(alpha, blended) : nullptr);
       L += policy.throughput() *

@@ -88,15 +88,17 @@ AlbedoCurve blend(const AlbedoCurve& a, const AlbedoCurve& b, double w) {
 
 }  // namespace
 
-const MicrofacetAlbedo* MicrofacetAlbedoLevels::at(double alpha, MicrofacetAlbedo& scratch) const {
+const MicrofacetAlbedo* MicrofacetAlbedoLevels::at(double alpha,
+                                                   std::optional<MicrofacetAlbedo>& scratch) const {
   if (levels.size() == 1) return &levels[0];
   const double x =
       std::clamp((alpha - alpha0) / (alpha1 - alpha0), 0.0, 1.0) * double(levels.size() - 1);
   const size_t i = std::min(levels.size() - 2, static_cast<size_t>(x));
   const double w = x - double(i);
-  scratch.outside = blend(levels[i].outside, levels[i + 1].outside, w);
-  scratch.inside = blend(levels[i].inside, levels[i + 1].inside, w);
-  return &scratch;
+  scratch.emplace();
+  scratch->outside = blend(levels[i].outside, levels[i + 1].outside, w);
+  scratch->inside = blend(levels[i].inside, levels[i + 1].inside, w);
+  return &*scratch;
 }
 
 }  // namespace nimbus

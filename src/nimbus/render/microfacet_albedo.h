@@ -9,6 +9,7 @@
 // the table is the same in every run.
 
 #include <array>
+#include <optional>
 #include <vector>
 
 namespace nimbus {
@@ -42,8 +43,9 @@ struct MicrofacetAlbedoLevels {
   static constexpr int kLevels = 9;
   double alpha0 = 0, alpha1 = 0;
   std::vector<MicrofacetAlbedo> levels;
-  // The tables at α: a level itself, or `scratch` filled with the blend of the two around α.
-  const MicrofacetAlbedo* at(double alpha, MicrofacetAlbedo& scratch) const;
+  // The tables at α: a level itself, or `scratch` made the blend of the two around α (only a
+  // textured roughness makes one: a table is 70 numbers).
+  const MicrofacetAlbedo* at(double alpha, std::optional<MicrofacetAlbedo>& scratch) const;
 };
 
 MicrofacetAlbedoLevels microfacet_albedo_levels(const Surface& s);

@@ -360,6 +360,12 @@ class Loader {
     });
   }
 
+  // The keys a rough dielectric and a conductor share: "roughness", "multiple_scattering".
+  static void read_microfacet_keys(JsonObject& so, SurfaceDesc& s) {
+    if (auto r = so.optional("roughness")) s.roughness_texture = read_roughness(*r, s);
+    if (auto m = so.optional("multiple_scattering")) s.multiple_scattering = m->boolean();
+  }
+
   static MediumDesc read_medium(const std::string& name, const JsonValue& v) {
     JsonObject o(v);
     MediumDesc m;
@@ -431,10 +437,7 @@ class Loader {
           break;
         case SurfaceDesc::Type::Dielectric:
           if (auto i = so.optional("ior")) obj.surface.ior = i->number(at_least(1));
-          if (auto r = so.optional("roughness"))
-            obj.surface.roughness_texture = read_roughness(*r, obj.surface);
-          if (auto m = so.optional("multiple_scattering"))
-            obj.surface.multiple_scattering = m->boolean();
+          read_microfacet_keys(so, obj.surface);
           break;
         case SurfaceDesc::Type::Conductor:
           if (auto m = so.optional("metal")) {
@@ -448,10 +451,7 @@ class Loader {
             obj.surface.eta = read_colour(so.required("eta"), SpectralRole::Unbounded, above(0));
             obj.surface.k = read_colour(so.required("k"), SpectralRole::Unbounded, at_least(0));
           }
-          if (auto r = so.optional("roughness"))
-            obj.surface.roughness_texture = read_roughness(*r, obj.surface);
-          if (auto m = so.optional("multiple_scattering"))
-            obj.surface.multiple_scattering = m->boolean();
+          read_microfacet_keys(so, obj.surface);
           break;
         case SurfaceDesc::Type::Emissive:
           obj.surface.radiance =
