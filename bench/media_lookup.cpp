@@ -93,7 +93,7 @@ void Lookup(benchmark::State& state) {
   }
   size_t media = 0, listed = 0;
   for (const Vec3& x : points) {
-    for_each_medium_at(p.scene, x, -1, [&](int, double, double) { ++media; });
+    for_each_medium_at(p.scene, x, -1, [&](int, double, double, int) { ++media; });
     listed += members_at(p.scene.field_grid, x).size();
   }
   state.counters["lookups/s"] =

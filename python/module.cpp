@@ -436,11 +436,13 @@ py::tuple media_at(const PyScene& scene, const Rows& points) {
     tbb::parallel_for(size_t{0}, p.size(), [&](size_t i) {
       Rgb mu_a(0.0), mu_s(0.0);
       const Vec3 x = p[i];
-      for_each_medium_at(sc, x, solid_containing(sc, x), [&](int m, double density, double F) {
-        const Medium& med = sc.media[size_t(m)];
-        mu_a += textured_rgb(med.sigma_a, med.sigma_a_to, med.sigma_a_texture, x, F) * density;
-        mu_s += textured_rgb(med.sigma_s, med.sigma_s_to, med.sigma_s_texture, x, F) * density;
-      });
+      for_each_medium_at(
+          sc, x, solid_containing(sc, x), [&](int m, double density, double F, int object) {
+            const Medium& med = sc.media[size_t(m)];
+            const Vec3 xt = texture_point(sc, sc.objects[size_t(object)], x);
+            mu_a += textured_rgb(med.sigma_a, med.sigma_a_to, med.sigma_a_texture, xt, F) * density;
+            mu_s += textured_rgb(med.sigma_s, med.sigma_s_to, med.sigma_s_texture, xt, F) * density;
+          });
       for (int c = 0; c < 3; ++c) {
         a[3 * i + c] = mu_a[c];
         b[3 * i + c] = mu_s[c];

@@ -103,7 +103,7 @@ TEST(ManyMedia, PointLookupsEqualTheLoopOverEveryObjectToTheBit) {
       ASSERT_EQ(fast.lobes, loop.lobes);
       EXPECT_LE(fast.lobes, 3);
       int present = 0;
-      for_each_medium_at(every, x, -1, [&](int, double, double) { ++present; });
+      for_each_medium_at(every, x, -1, [&](int, double, double, int) { ++present; });
       crowded += present > 8;
       const size_t n = members_at(scene.field_grid, x).size();
       listed += n;
@@ -158,7 +158,7 @@ TEST(ManyMedia, MediaOfOneAnisotropyShareALobeOfTheMixture) {
     // The mixture medium by medium, each object's own lobe.
     const double cos_theta = 2 * rng.uniform() - 1;
     Rgb sum(0.0);
-    for_each_medium_at(every, x, -1, [&](int medium, double density, double) {
+    for_each_medium_at(every, x, -1, [&](int medium, double density, double, int) {
       sum += ps.media[medium].sigma_s * density * hg_phase(cos_theta, scene.media[medium].g);
     });
     const Rgb p = phase_value(m, cos_theta);

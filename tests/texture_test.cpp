@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "nimbus/math/constants.h"
+#include "nimbus/math/mat4.h"
 #include "nimbus/math/rng.h"
 #include "nimbus/media/noise.h"
 #include "nimbus/media/pattern_density.h"
@@ -110,33 +111,56 @@ TEST(Patterns, StayInTheUnitIntervalVaryAndFollowTheirSeed) {
 // A diffuse floor whose albedo blends from 0.2 to 0.8 by sine bands (veins without turbulence),
 // seen from above through an orthographic camera, under a sky of radiance 1: each pixel is the
 // mean over its footprint of the albedo at the points it sees (the sky fills the hemisphere of
-// every point of the top face). The reference comes from the bands' formula; a floor whose
-// albedo runs from 0.25 fails the same test.
-TEST(TextureRender, TexturedAlbedoUnderAUniformSkyIsAlbedoTimesRadiance) {
-  const std::string text = R"({"film": {"width": 16, "height": 16},
-  "camera": {"type": "orthographic", "from": [0, 3, 0], "to": [0, 0, 0], "up": [0, 0, -1],
-             "width": 2},
-  "integrator": {"spp": 64, "seed": 3},
-  "lights": [{"type": "environment", "radiance": 1}],
-  "shapes": {"slab": {"type": "box", "min": [-20, -1, -20], "max": [20, 0, 20]}},
-  "objects": [{"shape": "slab", "surface": {"type": "diffuse", "albedo": {
-      "texture": {"type": "veins", "frequency": 0.8, "direction": [1, 0, 0.5], "turbulence": 0,
-                  "sharpness": 2},
-      "from": 0.2, "to": 0.8}}}]})";
+// every point of the top face). The reference comes from the bands' formula at the point in the
+// floor's own coordinates, to_object(x); a floor whose albedo runs from 0.25 fails the same test,
+// and so does a placed floor whose bands stayed in the scene's coordinates.
+void expect_textured_floor(const std::string& transform, const std::string& instances,
+                           const Mat4& to_object) {
+  SCOPED_TRACE(transform + instances);
+  const std::string text = fmt::format(R"({{"film": {{"width": 16, "height": 16}},
+  "camera": {{"type": "orthographic", "from": [0, 3, 0], "to": [0, 0, 0], "up": [0, 0, -1],
+             "width": 2}},
+  "integrator": {{"spp": 64, "seed": 3}},
+  "lights": [{{"type": "environment", "radiance": 1}}],
+  "shapes": {{"slab": {{"type": "box", "min": [-20, -1, -20], "max": [20, 0, 20]{}}}}},
+  "objects": [{{"shape": "slab", {}"surface": {{"type": "diffuse", "albedo": {{
+      "texture": {{"type": "veins", "frequency": 0.8, "direction": [1, 0, 0.5], "turbulence": 0,
+                  "sharpness": 2}},
+      "from": 0.2, "to": 0.8}}}}}}]}})",
+                                       transform, instances);
   const Scene scene = compile_scene(load_scene_text(text, "texture_test"));
   const RenderResult r = render_text(text);
   const Vec3 d = normalize(Vec3{1, 0, 0.5});
-  auto reference = [&](double from) {
+  auto reference = [&](double from, const Mat4& frame) {
     return test::pixel_references(scene.camera, 16, 16, 16, [&](const Ray& ray) {
       const Vec3 x = ray.at(-ray.o.y / ray.d.y);
-      return Rgb(from + (0.8 - from) * sine_bands(0.8, d, 2, x));
+      return Rgb(from + (0.8 - from) * sine_bands(0.8, d, 2, transform_point(frame, x)));
     });
   };
-  const std::vector<Rgb> ref = reference(0.2), wrong = reference(0.25);
+  const std::vector<Rgb> ref = reference(0.2, to_object), wrong = reference(0.25, to_object);
   const test::Chi2 chi2 = test::film_chi2(r.film, [&](int p) { return ref[size_t(p)]; });
   EXPECT_EQ(chi2.dof, 16 * 16 * 3);
   EXPECT_TRUE(chi2.passes()) << "chi2 " << chi2.value << " over " << chi2.dof;
   EXPECT_FALSE(test::film_chi2(r.film, [&](int p) { return wrong[size_t(p)]; }).passes());
+  if (to_object.m != Mat4::identity().m) {
+    const std::vector<Rgb> in_scene = reference(0.2, Mat4::identity());
+    EXPECT_FALSE(test::film_chi2(r.film, [&](int p) { return in_scene[size_t(p)]; }).passes());
+  }
+}
+
+TEST(TextureRender, TexturedAlbedoUnderAUniformSkyIsAlbedoTimesRadiance) {
+  expect_textured_floor("", "", Mat4::identity());
+}
+
+// The texture is a function of the object's own coordinates: it moves with the shape's
+// transform, and with an instance's placement on top of it.
+TEST(TextureRender, TexturesFollowTheirObjectsTransformAndInstance) {
+  const std::string transform =
+      R"(, "transform": [{"translate": [0.3, 0, 0.1]}, {"rotate": {"axis": [0, 1, 0], "degrees": 35}}])";
+  const Mat4 shape = Mat4::rotate({0, 1, 0}, 35) * Mat4::translate({0.3, 0, 0.1});
+  expect_textured_floor(transform, "", inverse(shape));
+  expect_textured_floor(transform, R"("instances": [[{"translate": [0.45, 0, -0.15]}]], )",
+                        inverse(Mat4::translate({0.45, 0, -0.15}) * shape));
 }
 
 // Chi-square of a size × size render against reference pixels over 3 × 3 blocks: a binary

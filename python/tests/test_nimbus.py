@@ -437,8 +437,8 @@ def test_rough_metals_and_their_errors_through_a_dict():
 
 def test_solid_textures_through_a_dict():
     """Solid textures from Python: a floor whose albedo follows bands renders brighter where the
-    bands say so, media_at reports a textured sigma_a at a point, and a texture where none is
-    taken is the loader's one line."""
+    bands say so, media_at reports a textured sigma_a at a point, in the object's own
+    coordinates, and a texture where none is taken is the loader's one line."""
     veins = {"type": "veins", "frequency": 0.25, "turbulence": 0, "direction": [1, 0, 0]}
     document = {
         "film": {"width": 16, "height": 4},
@@ -459,6 +459,10 @@ def test_solid_textures_through_a_dict():
     x = np.array([0.5, -0.5])
     sigma_a, _ = scene.media_at(np.stack([x, [-5.0, -5.0], [0.0, 0.0]], axis=1))
     assert np.allclose(sigma_a[:, 0], 0.5 + 2.0 * (1 + np.sin(np.pi * x / 2)) / 2)
+    # Textures are in the object's own coordinates: a moved sphere carries its texture along.
+    document["objects"][1]["shape"]["transform"] = [{"translate": [0.75, 0, 0]}]
+    moved, _ = nimbus.load_dict(document).media_at(np.stack([x + 0.75, [-5.0, -5.0], [0.0, 0.0]], axis=1))
+    assert np.allclose(moved, sigma_a)
     document["objects"][0]["surface"] = {"type": "dielectric", "ior": {"texture": veins}}
     with pytest.raises(nimbus.SceneError, match=r"/objects/0/surface/ior: takes no texture"):
         nimbus.load_dict(document)

@@ -15,6 +15,7 @@
 
 #include "nimbus/frep/intersect.h"
 #include "nimbus/math/box.h"
+#include "nimbus/math/mat4.h"
 #include "nimbus/math/ray.h"
 #include "nimbus/media/media_scene.h"
 #include "nimbus/media/medium.h"
@@ -50,8 +51,9 @@ struct MediumPoint {
 // The density (the factor on sigma_a, sigma_s) of `medium` at x, where its object's F is F.
 double medium_density(const Medium& medium, const Vec3& x, double F);
 
-// Calls f(medium index, density, F) for each medium present at x, seen from `inside`, the solid
-// object the point is in (-1: none), in the order of the scene's field objects. In the field,
+// Calls f(medium index, density, F, object index) for each medium present at x, seen from
+// `inside`, the solid object the point is in (-1: none), in the order of the scene's field
+// objects. In the field,
 // a scene with a member grid (member_grid.h) looks only at the objects listed for x's cell.
 template <MediumHolders S, class F>
 void for_each_medium_at(const S& scene, const Vec3& x, int inside, F&& f) {
@@ -61,16 +63,16 @@ void for_each_medium_at(const S& scene, const Vec3& x, int inside, F&& f) {
     const Medium& medium = scene.media[obj.medium];
     const double F_x = medium_uses_F(medium) ? evaluate(obj.tape, x) : 1.0;
     const double d = medium_density(medium, x, F_x);
-    if (d > 0) f(obj.medium, d, F_x);
+    if (d > 0) f(obj.medium, d, F_x, inside);
     return;
   }
-  // The medium of an object whose bounds hold x and whose F there is F_x.
-  auto add = [&](int medium, double F_x) {
+  // The medium of object i, whose bounds hold x and whose F there is F_x.
+  auto add = [&](int medium, double F_x, int i) {
     if (F_x <= 0) return;
     const double d = medium_density(scene.media[medium], x, F_x);
-    if (d > 0) f(medium, d, F_x);
+    if (d > 0) f(medium, d, F_x, i);
   };
-  auto visit = [&](int i) { add(scene.objects[i].medium, evaluate(scene.objects[i].tape, x)); };
+  auto visit = [&](int i) { add(scene.objects[i].medium, evaluate(scene.objects[i].tape, x), i); };
   if constexpr (requires { scene.field_grid; }) {
     const MemberGrid& grid = scene.field_grid;
     if (!grid.begin.empty()) {
@@ -78,7 +80,8 @@ void for_each_medium_at(const S& scene, const Vec3& x, int inside, F&& f) {
       // Object k, whose bounds hold x (inlined at both calls: as a call it cost four puffs 9 %).
       auto take = [&](std::int32_t k) __attribute__((always_inline)) {
         if (grid.single[k])
-          add(grid.medium[k], grid.objects[k].quadric.eval(x));  // as evaluate(tape, x), to the bit
+          add(grid.medium[k], grid.objects[k].quadric.eval(x),  // as evaluate(tape, x), to the bit
+              scene.field_objects[k]);
         else
           visit(scene.field_objects[k]);
       };
@@ -113,18 +116,32 @@ void for_each_medium_at(const S& scene, const Vec3& x, int inside, F&& f) {
     if (scene.objects[i].bounds.contains(x)) visit(i);
 }
 
+// Where the textures of object i are evaluated for the scene point x: in its own coordinates
+// where the scene places textured objects by frames (render/scene.h, texture_point), else x.
+template <MediumHolders S>
+Vec3 texture_point_of(const S& scene, int i, const Vec3& x) {
+  if constexpr (requires { scene.texture_frames; }) {
+    const int frame = scene.objects[size_t(i)].texture_frame;
+    return frame < 0 ? x : transform_point(scene.texture_frames[size_t(frame)], x);
+  } else {
+    return x;
+  }
+}
+
 namespace medium_field_detail {
 
 // Adds a medium of coefficients c at density `density` at x, where its object's F is F, to the
-// sums mu_a, mu_s and mu_a_Le = Σ mu_a,i L_e,i; returns the medium's own mu_s.
+// sums mu_a, mu_s and mu_a_Le = Σ mu_a,i L_e,i; returns the medium's own mu_s. Its textures are
+// evaluated at x_texture, x in the object's coordinates.
 template <int N>
-Spectrum<N> add_medium(const MediumCoefficients<N>& c, double density, const Vec3& x, double F,
-                       Spectrum<N>& mu_a, Spectrum<N>& mu_s, Spectrum<N>& mu_a_Le) {
+Spectrum<N> add_medium(const MediumCoefficients<N>& c, double density, const Vec3& x,
+                       const Vec3& x_texture, double F, Spectrum<N>& mu_a, Spectrum<N>& mu_s,
+                       Spectrum<N>& mu_a_Le) {
   Spectrum<N> a = c.sigma_a, s = c.sigma_s;
   if (c.sigma_a_texture) [[unlikely]]
-    a += (c.sigma_a_to - c.sigma_a) * c.sigma_a_texture->at(x, F);
+    a += (c.sigma_a_to - c.sigma_a) * c.sigma_a_texture->at(x_texture, F);
   if (c.sigma_s_texture) [[unlikely]]
-    s += (c.sigma_s_to - c.sigma_s) * c.sigma_s_texture->at(x, F);
+    s += (c.sigma_s_to - c.sigma_s) * c.sigma_s_texture->at(x_texture, F);
   a *= density;
   s *= density;
   mu_a += a;
@@ -147,10 +164,12 @@ void medium_at(const S& scene, const std::vector<MediumCoefficients<N>>& coeffic
                const Vec3& x, int inside, MediumPoint<N>& m) {
   m.mu_a = m.mu_s = m.mu_a_Le = Spectrum<N>(0.0);
   m.lobes = 0;
-  for_each_medium_at(scene, x, inside, [&](int medium, double density, double F) {
+  for_each_medium_at(scene, x, inside, [&](int medium, double density, double F, int object) {
     const MediumCoefficients<N>& c = coefficients[medium];
+    const Vec3 x_texture =
+        c.sigma_a_texture || c.sigma_s_texture ? texture_point_of(scene, object, x) : x;
     const Spectrum<N> mu_s_i =
-        medium_field_detail::add_medium(c, density, x, F, m.mu_a, m.mu_s, m.mu_a_Le);
+        medium_field_detail::add_medium(c, density, x, x_texture, F, m.mu_a, m.mu_s, m.mu_a_Le);
     const double g = scene.media[medium].g;
     int lobe = 0;
     while (lobe < m.lobes && m.g[lobe] != g) ++lobe;
@@ -182,8 +201,11 @@ void medium_sums_at(const S& scene, const std::vector<MediumCoefficients<N>>& co
                     const Vec3& x, int inside, Spectrum<N>& mu_a, Spectrum<N>& mu_s,
                     Spectrum<N>& mu_a_Le) {
   mu_a = mu_s = mu_a_Le = Spectrum<N>(0.0);
-  for_each_medium_at(scene, x, inside, [&](int medium, double density, double F) {
-    medium_field_detail::add_medium(coefficients[medium], density, x, F, mu_a, mu_s, mu_a_Le);
+  for_each_medium_at(scene, x, inside, [&](int medium, double density, double F, int object) {
+    const MediumCoefficients<N>& c = coefficients[medium];
+    const Vec3 x_texture =
+        c.sigma_a_texture || c.sigma_s_texture ? texture_point_of(scene, object, x) : x;
+    medium_field_detail::add_medium(c, density, x, x_texture, F, mu_a, mu_s, mu_a_Le);
   });
 }
 

@@ -312,7 +312,7 @@ void sample_bounds(std::span<const Medium> media, std::span<const MemberObject> 
       Vec3 x;
       for (int k = 0; k < 3; ++k) x[k] = box.lo[k] + rng.uniform() * (box.hi[k] - box.lo[k]);
       std::fill(mu.begin(), mu.end(), 0.0);
-      for_each_medium_at(scene, x, inside, [&](int medium, double density, double) {
+      for_each_medium_at(scene, x, inside, [&](int medium, double density, double, int) {
         for (int b = 0; b < 2 * bins; ++b) mu[b] += density * sigma_t[medium][b];
       });
       for (int b = 0; b < bins; ++b) {

@@ -30,8 +30,10 @@ class FirstVertexRecorder {
   // An object's surface at distance t, of outward normal n: a diffuse surface's reflectance, a
   // conductor's at normal incidence, an emissive surface's 0, the normal facing the ray; a
   // dielectric is passed through.
-  void surface(const Surface& s, const Ray& ray, double t, const Vec3& n) {
+  void surface(const Scene& scene, const SceneObject& object, const Ray& ray, double t,
+               const Vec3& n) {
     if (!pending_) return;
+    const Surface& s = object.surface;
     const Vec3 facing = dot(ray.d, n) < 0 ? n : -n;
     if (s.type == Surface::Type::Dielectric) {
       if (camera_ray_) set(Rgb(1.0), facing);
@@ -40,7 +42,8 @@ class FirstVertexRecorder {
     }
     camera_ray_ends(t);
     set(s.type == Surface::Type::Diffuse
-            ? textured_rgb(s.albedo, s.albedo_to, s.albedo_texture, ray.at(t), 0.0)
+            ? textured_rgb(s.albedo, s.albedo_to, s.albedo_texture,
+                           texture_point(scene, object, ray.at(t)), 0.0)
         : s.type == Surface::Type::Conductor ? conductor_reflectance(s)
                                              : Rgb(0.0),
         facing);

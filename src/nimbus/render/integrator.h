@@ -315,7 +315,7 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
     const SceneObject& obj = scene.objects[hit->object];
     const Vec3 p = ray.at(hit->t);
     const Vec3 n = outward_normal(obj, p);
-    record.surface(obj.surface, ray, hit->t, n);
+    record.surface(scene, obj, ray, hit->t, n);
     if (obj.surface.type == Surface::Type::Emissive) {
       // As for a sphere light: what the walk to emissive surfaces finds too is weighted against
       // it.
@@ -337,7 +337,7 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
       Spectrum<N> albedo = evaluate(obj.surface.albedo, ps.ch);
       if (obj.surface.albedo_texture) [[unlikely]]
         albedo += (evaluate(obj.surface.albedo_to, ps.ch) - albedo) *
-                  obj.surface.albedo_texture.at(p, 0.0);
+                  obj.surface.albedo_texture.at(texture_point(scene, obj, p), 0.0);
       const Spectrum<N> f = albedo * kInvPi;
       const ChainStart at{p, ns, true, inside};
       L += policy.throughput() * direct_light(
@@ -361,7 +361,7 @@ Spectrum<N> trace_path(const Scene& scene, const PathSpectra<N>& ps, Ray ray, Pa
       const bool two_sided = obj.surface.type == Surface::Type::Dielectric;
       const ChainStart at{p, two_sided || dot(wo, n) > 0 ? n : -n, true, inside,
                           two_sided ? hit->object : -1};
-      const double alpha = roughness_at(obj.surface, p);
+      const double alpha = roughness_at(obj.surface, texture_point(scene, obj, p));
       std::optional<MicrofacetAlbedo> blended;
       const Glossy<N> g(obj.surface, alpha, ps, at.n,
                         obj.albedo ? obj.albedo->at(alpha, blended) : nullptr);

@@ -25,7 +25,8 @@ struct Surface {
   double roughness_to = 0;
 };
 
-// The rough boundary's GGX α at the surface point x (the texture's F there is 0).
+// The rough boundary's GGX α at the surface point x, in the object's coordinates
+// (texture_point, scene.h); the texture's F there is 0.
 inline double roughness_at(const Surface& s, const Vec3& x) {
   return s.roughness_texture
              ? s.roughness + (s.roughness_to - s.roughness) * s.roughness_texture.at(x, 0.0)

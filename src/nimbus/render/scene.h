@@ -10,6 +10,7 @@
 #include "nimbus/frep/intersect.h"
 #include "nimbus/frep/tape.h"
 #include "nimbus/math/box.h"
+#include "nimbus/math/mat4.h"
 #include "nimbus/media/medium.h"
 #include "nimbus/media/member_grid.h"
 #include "nimbus/media/octree.h"
@@ -85,6 +86,9 @@ struct SceneObject {
   // The index of the description's object it comes from (one of its instances), or -1 for an
   // object built in code.
   int source = -1;
+  // Its textures' frame: an index into Scene::texture_frames, or -1 where the object's own
+  // coordinates are the scene's (texture_point).
+  int texture_frame = -1;
 };
 
 // Whether an object holding `medium` (an index, or -1) with a surface of this type has a majorant
@@ -130,6 +134,8 @@ struct Scene {
   double scale = 1;  // size of the scene's bounds, for ray offsets
   // The exponent of its films (film.h: film_exponent of brightest_emission; finish_scene).
   int film_exponent = 0;
+  // Scene-to-object maps of the textured objects placed by a transform (SceneObject).
+  std::vector<Mat4> texture_frames;
   // What compile_scene left out and why, one line each (an object whose shape is empty): the
   // command line prints them as warnings, the Python module raises them as UserWarning.
   std::vector<std::string> warnings;
@@ -177,6 +183,15 @@ MajorantOctree build_majorant_octree(const Scene& scene, int inside,
 // Call after the objects, media and tracking settings are final. The monitor sees the fraction
 // of all of them done; once cancelled, the scene must not be rendered.
 void build_majorant_octrees(Scene& scene, const BuildMonitor& monitor = {});
+
+// Where a texture of `object` is evaluated for the scene point x: in the object's own
+// coordinates, those of its shape before the shape's top-level transform and its instance's
+// placement, so that a texture moves with its object and every copy shows the same one.
+inline Vec3 texture_point(const Scene& scene, const SceneObject& object, const Vec3& x) {
+  return object.texture_frame < 0
+             ? x
+             : transform_point(scene.texture_frames[size_t(object.texture_frame)], x);
+}
 
 // The solid (dielectric) object containing p, the first in scene order if several do, or -1: a
 // path that starts there (the camera may sit inside one) starts in its medium. Asks the

@@ -247,6 +247,19 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
       obj.surface = compile_surface(od.surface, textures[k]);
       obj.medium = medium;
       obj.source = int(k);
+      // Textures are functions of the object's own coordinates: those before its shape's
+      // top-level transform and its instance's placement.
+      const bool textured = obj.surface.albedo_texture || obj.surface.roughness_texture ||
+                            (medium >= 0 && (scene.media[size_t(medium)].sigma_a_texture ||
+                                             scene.media[size_t(medium)].sigma_s_texture));
+      if (textured) {
+        const Mat4 to_scene = od.instances ? (*od.instances)[i - first[k]] * od.shape->transform
+                                           : od.shape->transform;
+        if (to_scene.m != Mat4::identity().m) {
+          obj.texture_frame = int(scene.texture_frames.size());
+          scene.texture_frames.push_back(inverse(to_scene));
+        }
+      }
       const double g = obj.medium >= 0 ? scene.media[obj.medium].g : 0;
       if (obj.surface.type == Surface::Type::None && obj.medium >= 0 &&
           std::find(field_g.begin(), field_g.end(), g) == field_g.end()) {

@@ -17,20 +17,21 @@ namespace {
 // inside.
 Rgb surface_colour(const Scene& scene, const SceneObject& object, const Vec3& x, double cos_eye) {
   const double shade = 0.2 + 0.8 * std::abs(cos_eye);
+  const Vec3 xt = texture_point(scene, object, x);
   switch (object.surface.type) {
     case Surface::Type::Emissive:
       return object.surface.radiance.rgb;
     case Surface::Type::Diffuse:
       return textured_rgb(object.surface.albedo, object.surface.albedo_to,
-                          object.surface.albedo_texture, x, 0.0) *
+                          object.surface.albedo_texture, xt, 0.0) *
              shade;
     case Surface::Type::Conductor:
       return conductor_reflectance(object.surface) * shade;
     case Surface::Type::Dielectric: {
       if (object.medium < 0) return Rgb(0.9) * shade;
       const Medium& m = scene.media[size_t(object.medium)];
-      const Rgb sigma_s = textured_rgb(m.sigma_s, m.sigma_s_to, m.sigma_s_texture, x, 0.0);
-      const Rgb mu_t = textured_rgb(m.sigma_a, m.sigma_a_to, m.sigma_a_texture, x, 0.0) + sigma_s;
+      const Rgb sigma_s = textured_rgb(m.sigma_s, m.sigma_s_to, m.sigma_s_texture, xt, 0.0);
+      const Rgb mu_t = textured_rgb(m.sigma_a, m.sigma_a_to, m.sigma_a_texture, xt, 0.0) + sigma_s;
       Rgb albedo(0.0);
       for (int c = 0; c < 3; ++c) albedo[c] = mu_t[c] > 0 ? sigma_s[c] / mu_t[c] : 0.0;
       return albedo * shade;
@@ -99,12 +100,13 @@ Image render_preview(const Scene& scene, const PreviewOptions& options) {
         for (int i = 0; i < steps; ++i) {
           const Vec3 p = ray.at(t0 + (i + 0.5) * dt);
           Rgb mu_a(0.0), mu_s(0.0), emitted(0.0);
-          for_each_medium_at(scene, p, -1, [&](int m, double density, double F) {
+          for_each_medium_at(scene, p, -1, [&](int m, double density, double F, int object) {
             const Medium& medium = scene.media[size_t(m)];
+            const Vec3 pt = texture_point(scene, scene.objects[size_t(object)], p);
             const Rgb a =
-                textured_rgb(medium.sigma_a, medium.sigma_a_to, medium.sigma_a_texture, p, F);
+                textured_rgb(medium.sigma_a, medium.sigma_a_to, medium.sigma_a_texture, pt, F);
             mu_a += a * density;
-            mu_s += textured_rgb(medium.sigma_s, medium.sigma_s_to, medium.sigma_s_texture, p, F) *
+            mu_s += textured_rgb(medium.sigma_s, medium.sigma_s_to, medium.sigma_s_texture, pt, F) *
                     density;
             emitted += a * medium.emission.rgb * density;
           });
