@@ -25,3 +25,4 @@ Command view_command(CLI::App& app);
 Command experiment_command(CLI::App& app);
 Command settings_command(CLI::App& app);
 Command export_vdb_command(CLI::App& app);
+Command export_mesh_command(CLI::App& app);

@@ -22,9 +22,9 @@ int run_command(int argc, char** argv, const Cluster& cluster) {
   CLI::App app{"nimbus: renders functionally specified objects and participating media"};
   app.set_version_flag("--version", std::string("nimbus ") + NIMBUS_VERSION);
   app.require_subcommand(1);
-  const std::vector<Command> commands = {render_command(app), view_command(app),
+  const std::vector<Command> commands = {render_command(app),     view_command(app),
                                          experiment_command(app), settings_command(app),
-                                         export_vdb_command(app)};
+                                         export_vdb_command(app), export_mesh_command(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

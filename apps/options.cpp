@@ -94,6 +94,10 @@ CLI::Validator aov_names() {
 }
 
 CLI::Validator positive_seconds() {
+  return positive_number("SECONDS");
+}
+
+CLI::Validator positive_number(const std::string& name) {
   return CLI::Validator(
       [](std::string& value) -> std::string {
         double x = 0;
@@ -108,7 +112,7 @@ CLI::Validator positive_seconds() {
         if (!(x > 0) || !std::isfinite(x)) return fmt::format("must be > 0, not {}", value);
         return {};
       },
-      "SECONDS > 0");
+      name + " > 0");
 }
 
 std::vector<std::string> comma_separated(const std::string& list) {

@@ -23,6 +23,8 @@ CLI::Validator display_address();
 CLI::Validator aov_names();
 // A number of seconds > 0.
 CLI::Validator positive_seconds();
+// A finite number > 0, shown in help as "NAME > 0".
+CLI::Validator positive_number(const std::string& name);
 
 // The items of "albedo,normal", empty ones included.
 std::vector<std::string> comma_separated(const std::string& list);

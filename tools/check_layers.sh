@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Checks that includes between the modules of src/nimbus point one way (docs/architecture.md,
 # "Dependency order"): a module includes itself and modules of a lower rank only (math and os,
-# and frep and spectral, share a rank and stay independent). Prints each include that runs upward or
+# frep and spectral, and media and mesh, share a rank and stay independent). Prints each include that runs upward or
 # sideways, and exits 1 if there is any.
 set -euo pipefail
 src="${1:-$(dirname "$0")/../src/nimbus}"
-declare -A rank=([math]=0 [os]=0 [frep]=1 [spectral]=1 [media]=2 [tracking]=3 [render]=4 [scene]=5
+declare -A rank=([math]=0 [os]=0 [frep]=1 [spectral]=1 [media]=2 [mesh]=2 [tracking]=3 [render]=4 [scene]=5
                  [io]=6 [job]=7 [experiments]=7 [view]=8)
 bad=0
 for module in "${!rank[@]}"; do

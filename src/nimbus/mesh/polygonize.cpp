@@ -1,0 +1,534 @@
+#include "nimbus/mesh/polygonize.h"
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <optional>
+#include <vector>
+
+#include "nimbus/frep/intersect.h"
+#include "nimbus/math/symmetric_eigen.h"
+
+namespace nimbus {
+
+namespace {
+
+// Grid corners sit off the round coordinates shapes are usually placed at: a shift of this many
+// cells, (3 − √5) / 2.
+constexpr double kGridShift = 0.3819660112501051;
+// The first grid has this many cells across the shape's largest extent.
+constexpr int kFirstCells = 16;
+// At most this many cells along an axis (a cell's key packs 21 bits per axis).
+constexpr int kMaxAxisCells = (1 << 21) - 2;
+// A cell whose corners share a sign is searched for a hidden piece of the shape down to boxes
+// this many times smaller (or the error bound, if larger).
+constexpr double kHiddenSearch = 8;
+// Cells per task when the pruning recursion runs in parallel.
+constexpr std::int64_t kParallelCells = 4096;
+
+using Cell = std::array<int, 3>;
+
+struct Grid {
+  Vec3 origin;
+  double h = 0;
+  Cell n{};  // cells per axis
+  Vec3 point(double i, double j, double k) const {
+    return {origin.x + i * h, origin.y + j * h, origin.z + k * h};
+  }
+  Vec3 corner(const Cell& c) const { return point(c[0], c[1], c[2]); }
+};
+
+std::uint64_t key(const Cell& c) {
+  return (std::uint64_t(c[0]) << 42) | (std::uint64_t(c[1]) << 21) | std::uint64_t(c[2]);
+}
+
+// The cells of [lo, hi) whose box interval arithmetic cannot prove free of the surface, in the
+// recursion's order (children by octant).
+// Whether interval arithmetic proves the box all inside (F > 0) or free of inside points
+// (F <= 0: culled quadrics are enclosed by [-inf, 0], whose upper end touches 0).
+bool one_sided(const Tape& tape, const Box& box) {
+  const Interval f = evaluate(tape, box);
+  return f.lo > 0 || f.hi <= 0;
+}
+
+std::vector<Cell> collect(const Tape& tape, const Grid& g, const Cell& lo, const Cell& hi) {
+  if (one_sided(tape, Box{g.corner(lo), g.corner(hi)})) return {};
+  if (hi[0] - lo[0] == 1 && hi[1] - lo[1] == 1 && hi[2] - lo[2] == 1) return {lo};
+  std::array<std::pair<Cell, Cell>, 8> parts;
+  int count = 0;
+  for (int o = 0; o < 8; ++o) {
+    Cell a = lo, b = hi;
+    bool empty = false;
+    for (int k = 0; k < 3; ++k) {
+      const int mid = lo[size_t(k)] + (hi[size_t(k)] - lo[size_t(k)] + 1) / 2;
+      if (o >> k & 1) {
+        a[size_t(k)] = mid;
+        empty |= mid >= hi[size_t(k)];
+      } else {
+        b[size_t(k)] = mid;
+      }
+    }
+    if (!empty) parts[size_t(count++)] = {a, b};
+  }
+  std::array<std::vector<Cell>, 8> found;
+  const std::int64_t volume =
+      std::int64_t(hi[0] - lo[0]) * std::int64_t(hi[1] - lo[1]) * std::int64_t(hi[2] - lo[2]);
+  auto visit = [&](int i) {
+    found[size_t(i)] = collect(tape, g, parts[size_t(i)].first, parts[size_t(i)].second);
+  };
+  if (volume > kParallelCells)
+    tbb::parallel_for(0, count, visit);
+  else
+    for (int i = 0; i < count; ++i) visit(i);
+  std::vector<Cell> out;
+  for (int i = 0; i < count; ++i)
+    out.insert(out.end(), found[size_t(i)].begin(), found[size_t(i)].end());
+  return out;
+}
+
+// Corner o of a cell (bit k: +1 along axis k).
+Cell corner_of(const Cell& c, int o) {
+  return {c[0] + (o & 1), c[1] + (o >> 1 & 1), c[2] + (o >> 2 & 1)};
+}
+
+// Cube edge e = 4 axis + (b1 + 2 b2): along `axis` from the corner whose bits on the other two
+// axes, (axis + 1) % 3 and (axis + 2) % 3, are b1 and b2.
+int edge_corner(int e, int end) {
+  const int axis = e / 4, b1 = e & 1, b2 = e >> 1 & 1;
+  return end << axis | b1 << ((axis + 1) % 3) | b2 << ((axis + 2) % 3);
+}
+int edge_of(int axis, int b1, int b2) {
+  return 4 * axis + b1 + 2 * b2;
+}
+
+// A root of F on a grid edge from a (lower) to b, and the outward normal there.
+struct EdgePoint {
+  Vec3 p, n;
+};
+
+Vec3 outward(const Tape& tape, const Vec3& p) {
+  const Vec3 g = gradient(tape, p);
+  const double len = length(g);
+  return len > 0 ? g * (-1 / len) : Vec3{0, 0, 0};
+}
+
+// The root of F nearest p on the line through p in direction d (unit), signed along d, within
+// `reach`; none if there is none.
+std::optional<double> nearest_root(const Tape& tape, const Vec3& p, const Vec3& d, double reach) {
+  // Each search starts a hair behind p, so that a root at p itself (a point on the surface, where
+  // F is 0 to round-off) is a sign change inside the interval.
+  const double hair = 1e-6 * reach;
+  std::optional<double> best;
+  if (const auto t = first_hit(tape, Ray{p - d * hair, d}, 0, reach + hair)) best = *t - hair;
+  const double behind = best ? std::abs(*best) : reach;
+  if (const auto t = first_hit(tape, Ray{p + d * hair, -d}, 0, behind + hair))
+    if (!best || *t - hair < std::abs(*best)) best = -(*t - hair);
+  return best;
+}
+
+EdgePoint edge_point(const Tape& tape, const Vec3& a, const Vec3& b, double fa) {
+  double t;
+  if (const auto hit = first_hit(tape, Ray{a, b - a}, 0, 1)) {
+    t = *hit;
+  } else {  // round-off kept the exact search from seeing the change: bisection
+    double lo = 0, hi = 1;
+    for (int i = 0; i < 60; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      ((evaluate(tape, a + (b - a) * mid) > 0) == (fa > 0) ? lo : hi) = mid;
+    }
+    t = 0.5 * (lo + hi);
+  }
+  const Vec3 p = a + (b - a) * t;
+  return {p, outward(tape, p)};
+}
+
+// The point minimising Σ (n_i · (x − p_i))², nearest the mass point along the directions the
+// planes leave free (eigenvalues below a tenth of the largest are dropped): on a sharp edge or
+// corner where the planes meet, on the mean plane elsewhere. The mass point where the solution
+// leaves the cell.
+Vec3 qef_vertex(const std::vector<EdgePoint>& points, const Box& cell, Vec3& mass) {
+  mass = Vec3{0, 0, 0};
+  for (const EdgePoint& e : points) mass += e.p;
+  mass = mass / double(points.size());
+  std::array<std::array<double, 3>, 3> ata{};
+  Vec3 r{0, 0, 0};  // Aᵀ (b − A mass)
+  for (const EdgePoint& e : points) {
+    const double d = dot(e.n, e.p - mass);
+    for (int i = 0; i < 3; ++i) {
+      r[i] += e.n[i] * d;
+      for (int j = 0; j < 3; ++j) ata[size_t(i)][size_t(j)] += e.n[i] * e.n[j];
+    }
+  }
+  const SymmetricEigen eig = symmetric_eigen(ata);
+  const double largest = std::max({eig.values[0], eig.values[1], eig.values[2]});
+  Vec3 x = mass;
+  for (int k = 0; k < 3; ++k)
+    if (eig.values[size_t(k)] > 0.1 * largest && largest > 0)
+      x += eig.vectors[size_t(k)] * (dot(eig.vectors[size_t(k)], r) / eig.values[size_t(k)]);
+  return cell.contains(x) ? x : mass;
+}
+
+struct CellVertices {
+  std::array<std::int8_t, 12> vertex_of_edge;  // a loop's index in the cell, or -1
+  int loops = 0;
+  std::uint32_t first = 0;  // global index of loop 0
+};
+
+int find(std::array<int, 12>& parent, int i) {
+  while (parent[size_t(i)] != i) i = parent[size_t(i)];
+  return i;
+}
+
+// The faces of a cube: axis, side, and the four corners in cyclic order.
+struct Face {
+  int axis, side;
+  std::array<int, 4> corners;
+};
+std::array<Face, 6> cube_faces() {
+  std::array<Face, 6> faces{};
+  int f = 0;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side) {
+      const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3, s = side << axis;
+      faces[size_t(f++)] = {axis, side, {s, s | 1 << a1, s | 1 << a1 | 1 << a2, s | 1 << a2}};
+    }
+  return faces;
+}
+
+// The cube edge joining two corners that differ in one bit.
+int edge_between(int c0, int c1) {
+  const int diff = c0 ^ c1, axis = diff == 1 ? 0 : diff == 2 ? 1 : 2;
+  const int low = c0 & c1, a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+  return edge_of(axis, low >> a1 & 1, low >> a2 & 1);
+}
+
+// One grid: the mesh, and whether a cell hides part of the shape between its corners (a piece
+// thinner than the cell that no corner sees).
+struct GridMesh {
+  TriangleMesh mesh;
+  std::uint64_t cells = 0;
+  double vertex_error = 0;
+  bool hidden = false;
+};
+
+// Whether the box, whose corners are all inside (or all outside), holds a point of the other
+// sign more than `depth` from the surface: a piece of the shape (or a hole) that the grid does
+// not see and whose loss would cost more than the error bound. Point values at the centres of
+// the boxes interval arithmetic cannot clear, down to boxes of size `finest`. A shallow cap of
+// the surface across a face is no such piece: its points lie within the cap's depth.
+bool hides_other_sign(const Tape& tape, const Box& box, bool inside, double depth, double finest) {
+  if (one_sided(tape, box)) return false;
+  const Vec3 x = box.center();
+  if ((evaluate(tape, x) > 0) != inside) {
+    const Vec3 n = outward(tape, x);
+    const Vec3 e = box.extent();
+    const double reach = 2 * std::max({e.x, e.y, e.z});
+    if (length(n) > 0 && distance_along(tape, x, n, reach) > depth) return true;
+  }
+  const Vec3 e = box.extent();
+  if (std::max({e.x, e.y, e.z}) <= finest) return false;
+  for (int o = 0; o < 8; ++o) {
+    Box child;
+    for (int k = 0; k < 3; ++k) {
+      const double mid = 0.5 * (box.lo[k] + box.hi[k]);
+      child.lo[k] = o >> k & 1 ? mid : box.lo[k];
+      child.hi[k] = o >> k & 1 ? box.hi[k] : mid;
+    }
+    if (hides_other_sign(tape, child, inside, depth, finest)) return true;
+  }
+  return false;
+}
+
+GridMesh mesh_grid(const Tape& tape, const Grid& g, double error) {
+  GridMesh out;
+  std::vector<Cell> cells = collect(tape, g, {0, 0, 0}, g.n);
+  std::sort(cells.begin(), cells.end(),
+            [](const Cell& a, const Cell& b) { return key(a) < key(b); });
+  out.cells = cells.size();
+  const std::array<Face, 6> faces = cube_faces();
+  std::vector<CellVertices> loops(cells.size());
+  std::vector<std::array<double, 8>> values(cells.size());
+  std::vector<char> hidden(cells.size(), 0);
+  // Loops: the sign changes on each face pair into segments (an ambiguous face by the sign at
+  // its centre), and segments join into the loops the surface makes on the cell's boundary.
+  tbb::parallel_for(std::size_t{0}, cells.size(), [&](std::size_t i) {
+    const Cell& c = cells[i];
+    std::array<double, 8>& f = values[i];
+    int inside = 0;
+    for (int o = 0; o < 8; ++o) {
+      f[size_t(o)] = evaluate(tape, g.corner(corner_of(c, o)));
+      inside += f[size_t(o)] > 0;
+    }
+    CellVertices& v = loops[i];
+    v.vertex_of_edge.fill(-1);
+    if (inside == 0 || inside == 8) {
+      hidden[i] = hides_other_sign(tape, Box{g.corner(c), g.corner(corner_of(c, 7))}, inside == 8,
+                                   error, std::max(error, g.h / kHiddenSearch));
+      return;
+    }
+    std::array<int, 12> parent;
+    std::iota(parent.begin(), parent.end(), 0);
+    auto join = [&](int a, int b) { parent[size_t(find(parent, a))] = find(parent, b); };
+    for (const Face& face : faces) {
+      std::array<int, 4> edge{};
+      std::array<bool, 4> changes{};
+      int count = 0;
+      for (int k = 0; k < 4; ++k) {
+        const int c0 = face.corners[size_t(k)], c1 = face.corners[size_t((k + 1) % 4)];
+        edge[size_t(k)] = edge_between(c0, c1);
+        changes[size_t(k)] = (f[size_t(c0)] > 0) != (f[size_t(c1)] > 0);
+        count += changes[size_t(k)];
+      }
+      if (count == 2) {
+        int first = -1;
+        for (int k = 0; k < 4; ++k)
+          if (changes[size_t(k)]) {
+            if (first < 0)
+              first = edge[size_t(k)];
+            else
+              join(first, edge[size_t(k)]);
+          }
+      } else if (count == 4) {
+        // Corners 0 and 2 share a sign. If the centre has it too they connect across the face,
+        // and the segments cut off corners 1 and 3; else corners 0 and 2.
+        const Cell lo = corner_of(c, face.side << face.axis);
+        Vec3 centre = g.corner(lo);
+        const int a1 = (face.axis + 1) % 3, a2 = (face.axis + 2) % 3;
+        centre[a1] = g.origin[a1] + (lo[size_t(a1)] + 0.5) * g.h;
+        centre[a2] = g.origin[a2] + (lo[size_t(a2)] + 0.5) * g.h;
+        const bool joined = (evaluate(tape, centre) > 0) == (f[size_t(face.corners[0])] > 0);
+        if (joined) {
+          join(edge[0], edge[1]);
+          join(edge[2], edge[3]);
+        } else {
+          join(edge[3], edge[0]);
+          join(edge[1], edge[2]);
+        }
+      }
+    }
+    std::array<std::int8_t, 12> loop_of_root;
+    loop_of_root.fill(-1);
+    for (int e = 0; e < 12; ++e) {
+      if ((f[size_t(edge_corner(e, 0))] > 0) == (f[size_t(edge_corner(e, 1))] > 0)) continue;
+      const int r = find(parent, e);
+      if (loop_of_root[size_t(r)] < 0) loop_of_root[size_t(r)] = std::int8_t(v.loops++);
+      v.vertex_of_edge[size_t(e)] = loop_of_root[size_t(r)];
+    }
+  });
+  out.hidden = std::any_of(hidden.begin(), hidden.end(), [](char h) { return h != 0; });
+  std::uint32_t total = 0;
+  for (CellVertices& v : loops) {
+    v.first = total;
+    total += std::uint32_t(v.loops);
+  }
+  TriangleMesh& mesh = out.mesh;
+  mesh.positions.resize(total);
+  mesh.normals.resize(total);
+  std::vector<double> vertex_error(cells.size(), 0);
+  // Vertices: each loop's quadratic error function over its edges' roots; then onto the
+  // surface along the gradient where it is more than ε/2 away.
+  tbb::parallel_for(std::size_t{0}, cells.size(), [&](std::size_t i) {
+    const CellVertices& v = loops[i];
+    if (v.loops == 0) return;
+    const Cell& c = cells[i];
+    std::array<std::vector<EdgePoint>, 12> points;
+    for (int e = 0; e < 12; ++e) {
+      const int loop = v.vertex_of_edge[size_t(e)];
+      if (loop < 0) continue;
+      const int a = edge_corner(e, 0), b = edge_corner(e, 1);
+      points[size_t(loop)].push_back(edge_point(tape, g.corner(corner_of(c, a)),
+                                                g.corner(corner_of(c, b)), values[i][size_t(a)]));
+    }
+    const Box box{g.corner(c), g.corner(corner_of(c, 7))};
+    for (int loop = 0; loop < v.loops; ++loop) {
+      const std::vector<EdgePoint>& pts = points[size_t(loop)];
+      Vec3 mass{0, 0, 0};
+      Vec3 x = qef_vertex(pts, box, mass);
+      // Onto the surface where it is more than ε/2 away: along the gradient, or where that line
+      // misses it (outside a curved sharp edge, past both faces), towards the mass point of the
+      // edges' roots, which lies on the solid's side of the edge.
+      Vec3 n = outward(tape, x);
+      double d = 0;
+      for (const bool along_gradient : {true, false}) {
+        const Vec3 dir = along_gradient ? n : mass - x;
+        if (!(length(dir) > 0)) continue;
+        const Vec3 u = normalize(dir);
+        const auto t = nearest_root(tape, x, u, 2 * g.h);
+        if (!t) {
+          d = 2 * g.h;
+          continue;
+        }
+        d = std::abs(*t);
+        if (d > 0.5 * error) {
+          x = x + u * *t;
+          d = 0;
+        }
+        break;
+      }
+      const Vec3 m = outward(tape, x);
+      if (length(m) > 0) n = m;
+      if (!(length(n) > 0)) {
+        for (const EdgePoint& p : pts) n += p.n;
+        n = length(n) > 0 ? normalize(n) : Vec3{0, 0, 1};
+      }
+      mesh.positions[v.first + std::uint32_t(loop)] = x;
+      mesh.normals[v.first + std::uint32_t(loop)] = n;
+      vertex_error[i] = std::max(vertex_error[i], d);
+    }
+  });
+  for (const double e : vertex_error) out.vertex_error = std::max(out.vertex_error, e);
+  // Faces: a quad around each grid edge with a sign change, of the four cells' loops there,
+  // emitted by the cell at the edge's lowest position; counter-clockwise seen from outside.
+  auto index_of = [&](const Cell& c) -> std::optional<std::size_t> {
+    const std::uint64_t k = key(c);
+    const auto it = std::lower_bound(cells.begin(), cells.end(), k,
+                                     [](const Cell& a, std::uint64_t b) { return key(a) < b; });
+    if (it == cells.end() || key(*it) != k) return std::nullopt;
+    return std::size_t(it - cells.begin());
+  };
+  std::vector<std::vector<std::array<std::uint32_t, 3>>> triangles(cells.size());
+  tbb::parallel_for(std::size_t{0}, cells.size(), [&](std::size_t i) {
+    const Cell& c = cells[i];
+    for (int axis = 0; axis < 3; ++axis) {
+      const int e = edge_of(axis, 1, 1);
+      const int lo = edge_corner(e, 0);
+      const double f0 = values[i][size_t(lo)], f1 = values[i][size_t(edge_corner(e, 1))];
+      if ((f0 > 0) == (f1 > 0)) continue;
+      const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+      Cell c1 = c, c2 = c, c3 = c;
+      c1[size_t(a1)] += 1;
+      c2[size_t(a1)] += 1;
+      c2[size_t(a2)] += 1;
+      c3[size_t(a2)] += 1;
+      const auto i1 = index_of(c1), i2 = index_of(c2), i3 = index_of(c3);
+      if (!i1 || !i2 || !i3) continue;  // at the grid's edge, which the padding keeps outside
+      auto vertex = [&](std::size_t k, int edge) {
+        return loops[k].first + std::uint32_t(loops[k].vertex_of_edge[size_t(edge)]);
+      };
+      std::array<std::uint32_t, 4> q = {vertex(i, e), vertex(*i1, edge_of(axis, 0, 1)),
+                                        vertex(*i2, edge_of(axis, 0, 0)),
+                                        vertex(*i3, edge_of(axis, 1, 0))};
+      if (!(f0 > 0)) std::swap(q[1], q[3]);  // outside at the low end: the normal points back
+      // The diagonal that follows the surface: across a sharp edge, the one along the edge,
+      // whose midpoint lies on it, rather than the one that cuts the corner.
+      const auto& p = mesh.positions;
+      const auto& nn = mesh.normals;
+      const double d02 = surface_distance(tape, (p[q[0]] + p[q[2]]) * 0.5,
+                                          normalize(nn[q[0]] + nn[q[2]] + Vec3{0, 0, 1e-12}), g.h);
+      const double d13 = surface_distance(tape, (p[q[1]] + p[q[3]]) * 0.5,
+                                          normalize(nn[q[1]] + nn[q[3]] + Vec3{0, 0, 1e-12}), g.h);
+      if (d02 < d13 || (d02 == d13 && length(p[q[0]] - p[q[2]]) <= length(p[q[1]] - p[q[3]]))) {
+        triangles[i].push_back({q[0], q[1], q[2]});
+        triangles[i].push_back({q[0], q[2], q[3]});
+      } else {
+        triangles[i].push_back({q[0], q[1], q[3]});
+        triangles[i].push_back({q[1], q[2], q[3]});
+      }
+    }
+  });
+  for (const auto& t : triangles) mesh.triangles.insert(mesh.triangles.end(), t.begin(), t.end());
+  return out;
+}
+
+// The largest distance from a face's sample points (centroid, edge midpoints) to the surface
+// (surface_distance along the face's normal).
+double face_error(const Tape& tape, const TriangleMesh& mesh, double reach) {
+  std::vector<double> worst(mesh.triangles.size(), 0);
+  tbb::parallel_for(std::size_t{0}, mesh.triangles.size(), [&](std::size_t i) {
+    const auto& t = mesh.triangles[i];
+    const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]];
+    const Vec3 n = cross(b - a, c - a);
+    if (!(length(n) > 0)) return;
+    const Vec3 u = normalize(n);
+    for (const Vec3& p : {(a + b + c) / 3.0, (a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5})
+      worst[i] = std::max(worst[i], surface_distance(tape, p, u, reach));
+  });
+  return worst.empty() ? 0.0 : *std::max_element(worst.begin(), worst.end());
+}
+
+}  // namespace
+
+double distance_along(const Tape& tape, const Vec3& p, const Vec3& d, double reach) {
+  const auto t = nearest_root(tape, p, d, reach);
+  return t ? std::min(std::abs(*t), reach) : reach;
+}
+
+double surface_distance(const Tape& tape, const Vec3& p, const Vec3& n, double reach) {
+  double d = distance_along(tape, p, n, reach);
+  if (d < reach) return d;
+  const Vec3 g = outward(tape, p);
+  for (const Vec3& w : {g, n + g, n - g})
+    if (length(w) > 0) d = std::min(d, distance_along(tape, p, normalize(w), reach));
+  for (int k = 0; k < 3 && d >= reach; ++k) {
+    Vec3 e{0, 0, 0};
+    e[k] = 1;
+    for (const Vec3& w : {e, n + e, n - e})
+      if (length(w) > 0) d = std::min(d, distance_along(tape, p, normalize(w), reach));
+  }
+  return d;
+}
+
+TriangleMesh polygonize(const Tape& tape, const PolygonizeOptions& options,
+                        PolygonizeReport* report) {
+  if (!(options.error > 0) || !std::isfinite(options.error))
+    throw PolygonizeError(fmt::format("the error bound must be > 0 (got {:g})", options.error));
+  if (!tape.bounds.bounded) throw PolygonizeError("the shape is unbounded");
+  const Box& bounds = tape.bounds.box;
+  if (bounds.empty())
+    throw PolygonizeError("the shape is empty (its function is positive nowhere)");
+  const Vec3 extent = bounds.extent();
+  const double size = std::max({extent.x, extent.y, extent.z});
+  PolygonizeReport r;
+  double h = size / kFirstCells;
+  std::uint64_t previous_cells = 0;
+  for (;;) {
+    Grid g;
+    g.h = h;
+    for (int k = 0; k < 3; ++k) {
+      g.origin[k] = bounds.lo[k] - (1 + kGridShift) * h;
+      const double cells = std::ceil((bounds.hi[k] - g.origin[k]) / h) + 1;
+      if (cells > kMaxAxisCells)
+        throw PolygonizeError(fmt::format(
+            "an error bound of {:g} needs a grid of {:.3g} cells along an axis; at most {} are "
+            "supported",
+            options.error, cells, kMaxAxisCells));
+      g.n[size_t(k)] = int(cells);
+    }
+    // Surface cells grow about four-fold per halving of the cell.
+    if (options.max_cells > 0 && previous_cells * 4 > options.max_cells)
+      throw PolygonizeError(fmt::format(
+          "an error bound of {:g} needs about {} grid cells at the surface (cell {:.3g}); the "
+          "limit is {}",
+          options.error, previous_cells * 4, h, options.max_cells));
+    GridMesh gm = mesh_grid(tape, g, options.error);
+    ++r.grids;
+    r.cell = h;
+    r.cells = gm.cells;
+    r.vertex_error = gm.vertex_error;
+    r.face_error = face_error(tape, gm.mesh, 2 * h);
+    previous_cells = std::max<std::uint64_t>(gm.cells, 1);
+    if (!gm.hidden && r.face_error <= options.error && !gm.mesh.triangles.empty()) {
+      if (report) *report = r;
+      return std::move(gm.mesh);
+    }
+    // On a smooth surface the faces' error falls four-fold per halving of the cell: refuse now a
+    // bound whose grid would pass the limit, rather than after meshing the grids on the way.
+    if (options.max_cells > 0 && r.face_error > options.error) {
+      const double halvings = std::ceil(std::log(r.face_error / options.error) / std::log(4.0));
+      const double estimate = double(previous_cells) * std::pow(4.0, halvings);
+      if (estimate > double(options.max_cells))
+        throw PolygonizeError(fmt::format(
+            "an error bound of {:g} needs about {:.3g} grid cells at the surface (cell {:.3g}); "
+            "the limit is {}",
+            options.error, estimate, h * std::pow(0.5, halvings), options.max_cells));
+    }
+    h *= 0.5;
+  }
+}
+
+}  // namespace nimbus
