@@ -21,10 +21,6 @@
 
 namespace {
 
-// What one surface cell of the finest grid costs while meshing, with the two triangles and the
-// vertex it adds: its key, corner values and loops, and the mesh's arrays (bytes, rounded up).
-constexpr std::uint64_t kBytesPerCell = 320;
-
 struct MeshArgs {
   std::string scene;
   std::string output;
@@ -71,7 +67,7 @@ int run_export_mesh(const MeshArgs& args) {
   TriangleMesh mesh;
   PolygonizeOptions options;
   options.error = args.error;
-  options.max_cells = available_memory() / kBytesPerCell;
+  options.max_cells = available_memory() / kPolygonizeBytesPerCell;
   double vertex_error = 0, face_error = 0;
   int meshed = 0;
   for (const SceneObject& obj : scene.objects) {
@@ -100,13 +96,13 @@ int run_export_mesh(const MeshArgs& args) {
     return kExitFailure;
   }
   if (!args.quiet)
-    std::fprintf(stderr,
-                 "nimbus: %d object(s), %zu triangles, %zu vertices; largest vertex error %.3g, face "
-                 "error %.3g (bound %g) in %.2f s -> %s\n",
-                 meshed, mesh.triangles.size(), mesh.positions.size(), vertex_error, face_error,
-                 args.error,
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
-                 args.output.c_str());
+    std::fprintf(
+        stderr,
+        "nimbus: %d object(s), %zu triangles, %zu vertices; largest vertex error %.3g, face "
+        "error %.3g (bound %g) in %.2f s -> %s\n",
+        meshed, mesh.triangles.size(), mesh.positions.size(), vertex_error, face_error, args.error,
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+        args.output.c_str());
   return 0;
 }
 

@@ -37,6 +37,8 @@
 #include "nimbus/io/output.h"
 #include "nimbus/job/render_job.h"
 #include "nimbus/media/medium_field.h"
+#include "nimbus/mesh/polygonize.h"
+#include "nimbus/render/memory_estimate.h"
 #include "nimbus/render/renderer.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
@@ -420,6 +422,36 @@ py::array_t<double> shape_first_hit(const PyShape& s, const Rows& origins, const
   return out;
 }
 
+// The shape's surface as a mesh to the error bound (mesh/polygonize.h): (vertices, faces,
+// normals), (n, 3) float64, (m, 3) uint32 and (n, 3) float64. ValueError for a bound <= 0, an
+// empty or unbounded shape, or one whose grid would need more memory than is available.
+py::tuple shape_mesh(const PyShape& s, double error) {
+  TriangleMesh mesh;
+  {
+    py::gil_scoped_release release;
+    try {
+      mesh = polygonize(s.tape, {error, available_memory() / kPolygonizeBytesPerCell});
+    } catch (const PolygonizeError& e) {
+      py::gil_scoped_acquire acquire;
+      throw py::value_error(e.what());
+    }
+  }
+  const auto n = py::ssize_t(mesh.positions.size()), m = py::ssize_t(mesh.triangles.size());
+  py::array_t<double> vertices({n, py::ssize_t(3)}), normals({n, py::ssize_t(3)});
+  py::array_t<std::uint32_t> faces({m, py::ssize_t(3)});
+  double* v = vertices.mutable_data();
+  double* nn = normals.mutable_data();
+  for (py::ssize_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      v[3 * i + k] = mesh.positions[size_t(i)][k];
+      nn[3 * i + k] = mesh.normals[size_t(i)][k];
+    }
+  std::uint32_t* f = faces.mutable_data();
+  for (py::ssize_t i = 0; i < m; ++i)
+    for (int k = 0; k < 3; ++k) f[3 * i + k] = mesh.triangles[size_t(i)][size_t(k)];
+  return py::make_tuple(vertices, faces, normals);
+}
+
 // The media's coefficients at points, in rgb, as a path finds them there: each present
 // medium's density times its sigma_a and sigma_s, summed (the index-matched media add), inside a
 // solid only its own medium. Returns (sigma_a, sigma_s), each (n, 3).
@@ -548,6 +580,7 @@ PYBIND11_MODULE(_core, m) {
       .def("values", &np::shape_values, py::arg("points"))
       .def("first_hit", &np::shape_first_hit, py::arg("origins"), py::arg("directions"),
            py::arg("t_max"))
+      .def("mesh", &np::shape_mesh, py::arg("error"))
       .def("bounds", [](const np::PyShape& s) -> py::object {
         const nimbus::Bounds& b = s.tape.bounds;
         if (b.box.empty()) return py::none();

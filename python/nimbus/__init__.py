@@ -195,6 +195,15 @@ class Shape:
         the shape is empty."""
         return self._shape.bounds()
 
+    def mesh(self, error):
+        """The surface as a closed triangle mesh to the error bound `error` (scene units, > 0):
+        (vertices, faces, normals), arrays of shape (n, 3) float64, (m, 3) uint32 (counter-
+        clockwise seen from outside) and (n, 3) float64 (the exact gradient's, outward). Every
+        vertex lies within `error` of the surface (docs/meshes.md). Releases the GIL. ValueError
+        for a bound <= 0, an empty or unbounded shape, or a bound whose grid would need more
+        memory than is available (the message gives the estimate)."""
+        return self._shape.mesh(float(error))
+
 
 def experiment_names():
     """The paper-reproduction experiments (docs/reproduction.md), in the order of its figures."""

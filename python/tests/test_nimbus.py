@@ -329,6 +329,32 @@ def test_shape_bounds_hold_the_inside():
     assert np.isinf(lo).any() and np.isinf(hi).any()
 
 
+def test_shape_mesh_is_closed_outward_and_near_the_surface():
+    """Shape.mesh: a ball's vertices within the bound of the sphere, its enclosed volume within
+    0.5 %, every edge used twice in opposite directions, normals outward; bad bounds and shapes
+    are ValueErrors."""
+    ball = nimbus.Shape({"type": "sphere", "center": [0.2, 0, 0], "radius": 1})
+    v, f, n = ball.mesh(error=0.002)
+    assert v.dtype == np.float64 and f.dtype == np.uint32 and n.shape == v.shape
+    assert np.abs(np.linalg.norm(v - [0.2, 0, 0], axis=1) - 1).max() <= 0.002
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    volume = np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6
+    assert abs(volume - 4 / 3 * np.pi) < 0.005 * 4 / 3 * np.pi
+    edges = set(map(tuple, np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]).tolist()))
+    assert len(edges) == 3 * len(f) and all((q, p) in edges for p, q in edges)
+    assert (np.einsum("ij,ij->i", n, v - [0.2, 0, 0]) > 0.99).all()
+    blob_v, _, _ = nimbus.Shape(BLOB, NAMED).mesh(0.01)
+    assert np.abs(nimbus.Shape(BLOB, NAMED).values(blob_v)).max() < 0.1
+    with pytest.raises(ValueError, match="must be > 0"):
+        ball.mesh(0)
+    with pytest.raises(ValueError, match="empty"):
+        nimbus.Shape({"type": "intersection", "shapes": [
+            {"type": "sphere", "radius": 1}, {"type": "sphere", "center": [5, 0, 0], "radius": 1}]}
+        ).mesh(0.01)
+    with pytest.raises(ValueError, match="unbounded"):
+        nimbus.Shape({"type": "halfspace", "normal": [0, 1, 0]}).mesh(0.01)
+
+
 def test_bad_shapes_and_arrays_are_refused():
     with pytest.raises(nimbus.SceneError, match=r"^<shape>: /shape/radius: must be in \[1e-100"):
         nimbus.Shape({"type": "sphere", "radius": -1})

@@ -16,6 +16,11 @@
 
 namespace nimbus {
 
+// What one surface cell of the finest grid costs while meshing, with the two triangles and the
+// vertex it adds: its key, corner values and loops, and the mesh's arrays (bytes, rounded up).
+// max_cells for a memory budget is the budget over this.
+inline constexpr std::uint64_t kPolygonizeBytesPerCell = 320;
+
 struct PolygonizeOptions {
   double error = 0;             // ε > 0, scene units
   std::uint64_t max_cells = 0;  // refuse a grid estimated to need more surface cells; 0: no limit
