@@ -2,10 +2,12 @@
 // mesh to an error bound (mesh/polygonize.h, io/mesh_file.h).
 
 #include <fmt/format.h>
+#include <tbb/global_control.h>
 
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -27,6 +29,7 @@ struct MeshArgs {
   double error = 0;
   int object = -1;  // -1: every object
   bool all = false;
+  int threads = 0;  // 0: all cores
   std::vector<std::string> sets;
   bool quiet = false;
 };
@@ -63,7 +66,11 @@ int run_export_mesh(const MeshArgs& args) {
     std::fprintf(stderr, "nimbus: %s\n", e.what());
     return kExitBadInput;
   }
-  // Every copy of the chosen objects, placed (their tapes are in the scene's space).
+  // Every copy of the chosen objects, placed (their tapes are in the scene's space). The mesh is
+  // the same for any number of threads.
+  std::optional<tbb::global_control> threads;
+  if (args.threads > 0)
+    threads.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(args.threads));
   TriangleMesh mesh;
   PolygonizeOptions options;
   options.error = args.error;
@@ -124,6 +131,8 @@ Command export_mesh_command(CLI::App& app) {
                                  "Index into the scene's objects (its instances included)")
                      ->check(integer_in(0));
   cmd->add_flag("--all", args->all, "Every object (the default)")->excludes(object);
+  cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")
+      ->check(integer_in(1));
   cmd->add_option("--set", args->sets, "Override a scene key, as for render; repeatable");
   cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
   return {cmd, [args](const Cluster&) { return run_export_mesh(*args); }};

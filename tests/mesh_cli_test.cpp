@@ -123,6 +123,11 @@ TEST_F(MeshCli, ThreeFormatsOfOneClosedMeshWithTransformsAndInstances) {
   stl.read(reinterpret_cast<char*>(&count), 4);
   EXPECT_EQ(count, m.triangles.size());
   EXPECT_EQ(fs::file_size(file("out.stl")), 84 + 50 * std::uintmax_t(count));
+  // The same bytes on one thread.
+  ASSERT_EQ(run("export-mesh scene.json --error 0.002 --threads 1 -q -o one.ply").code, 0);
+  std::ifstream a(file("out.ply"), std::ios::binary), b(file("one.ply"), std::ios::binary);
+  EXPECT_TRUE(
+      std::equal(std::istreambuf_iterator<char>(a), {}, std::istreambuf_iterator<char>(b), {}));
   // --object 1 meshes the pebble's two instances alone.
   ASSERT_EQ(run("export-mesh scene.json --object 1 --error 0.002 -q -o pebbles.ply").code, 0);
   EXPECT_EQ(nimbus::mesh_topology(read_ply(file("pebbles.ply"))).components, 2);
