@@ -56,9 +56,7 @@ int run_export_mesh(const MeshArgs& args) {
     desc.settings.tracking.majorant_source = TrackingSettings::MajorantSource::Bound;
     std::vector<InputFile> read;
     scene = compile_scene(desc, {}, &read);
-    std::vector<NamedFile> inputs = {{"the scene file", args.scene}};
-    for (const InputFile& f : read) inputs.push_back({"the file of " + f.pointer, f.path});
-    check_outputs_distinct({{"-o", args.output}}, inputs);
+    check_outputs_distinct({{"-o", args.output}}, scene_inputs(args.scene, read));
   } catch (const SceneError& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return kExitBadInput;

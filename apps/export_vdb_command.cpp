@@ -25,14 +25,6 @@
 
 namespace {
 
-// The files a run reads: the scene file and every file compiling it read.
-std::vector<nimbus::NamedFile> scene_inputs(const std::string& scene,
-                                            const std::vector<nimbus::InputFile>& read) {
-  std::vector<nimbus::NamedFile> inputs = {{"the scene file", scene}};
-  for (const nimbus::InputFile& f : read) inputs.push_back({"the file of " + f.pointer, f.path});
-  return inputs;
-}
-
 struct ExportArgs {
   std::string scene;
   std::string output;

@@ -97,4 +97,12 @@ void check_outputs_distinct(const std::vector<NamedFile>& outputs,
   }
 }
 
+std::vector<NamedFile> scene_inputs(const std::string& scene_file,
+                                    const std::vector<InputFile>& read) {
+  std::vector<NamedFile> inputs;
+  if (!scene_file.empty()) inputs.push_back({"the scene file", scene_file});
+  for (const InputFile& f : read) inputs.push_back({"the file of " + f.pointer, f.path});
+  return inputs;
+}
+
 }  // namespace nimbus

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "nimbus/io/image.h"
+#include "nimbus/scene/input_file.h"
 
 namespace nimbus {
 
@@ -28,6 +29,11 @@ struct NamedFile {
   std::string what;
   std::string path;
 };
+
+// The files a run of `scene_file` reads: the scene file ("the scene file") and each file
+// compiling it read ("the file of /media/cloud/density/file"), for check_outputs_distinct.
+std::vector<NamedFile> scene_inputs(const std::string& scene_file,
+                                    const std::vector<InputFile>& read);
 
 // Whether two paths name one file: the same device and inode where both exist, else the same
 // absolute path once the links along it that exist are resolved.

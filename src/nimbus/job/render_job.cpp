@@ -296,9 +296,7 @@ std::string RenderJob::summary(const JobOutcome& outcome) const {
 }
 
 std::vector<NamedFile> RenderJob::files_read() const {
-  std::vector<NamedFile> read;
-  if (!scene_file_.empty()) read.push_back({"the scene file", scene_file_});
-  for (const InputFile& f : inputs_) read.push_back({"the file of " + f.pointer, f.path});
+  std::vector<NamedFile> read = scene_inputs(scene_file_, inputs_);
   if (!options_.resume.empty() && !options_.checkpoint.empty() &&
       !same_file(options_.resume, options_.checkpoint))
     read.push_back({"the checkpoint of --resume", options_.resume});
