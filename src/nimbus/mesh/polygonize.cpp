@@ -47,8 +47,6 @@ std::uint64_t key(const Cell& c) {
   return (std::uint64_t(c[0]) << 42) | (std::uint64_t(c[1]) << 21) | std::uint64_t(c[2]);
 }
 
-// The cells of [lo, hi) whose box interval arithmetic cannot prove free of the surface, in the
-// recursion's order (children by octant).
 // Whether interval arithmetic proves the box all inside (F > 0) or free of inside points
 // (F <= 0: culled quadrics are enclosed by [-inf, 0], whose upper end touches 0).
 bool one_sided(const Tape& tape, const Box& box) {
@@ -56,6 +54,8 @@ bool one_sided(const Tape& tape, const Box& box) {
   return f.lo > 0 || f.hi <= 0;
 }
 
+// The cells of [lo, hi) whose box interval arithmetic cannot prove one-sided, in the
+// recursion's order (children by octant).
 std::vector<Cell> collect(const Tape& tape, const Grid& g, const Cell& lo, const Cell& hi) {
   if (one_sided(tape, Box{g.corner(lo), g.corner(hi)})) return {};
   if (hi[0] - lo[0] == 1 && hi[1] - lo[1] == 1 && hi[2] - lo[2] == 1) return {lo};
@@ -224,14 +224,13 @@ struct GridMesh {
 bool hides_other_sign(const Tape& tape, const Box& box, bool inside, double depth, double finest) {
   if (one_sided(tape, box)) return false;
   const Vec3 x = box.center();
+  const Vec3 e = box.extent();
+  const double size = std::max({e.x, e.y, e.z});
   if ((evaluate(tape, x) > 0) != inside) {
     const Vec3 n = outward(tape, x);
-    const Vec3 e = box.extent();
-    const double reach = 2 * std::max({e.x, e.y, e.z});
-    if (length(n) > 0 && distance_along(tape, x, n, reach) > depth) return true;
+    if (length(n) > 0 && distance_along(tape, x, n, 2 * size) > depth) return true;
   }
-  const Vec3 e = box.extent();
-  if (std::max({e.x, e.y, e.z}) <= finest) return false;
+  if (size <= finest) return false;
   for (int o = 0; o < 8; ++o) {
     Box child;
     for (int k = 0; k < 3; ++k) {
@@ -326,6 +325,25 @@ GridMesh mesh_grid(const Tape& tape, const Grid& g, double error) {
     v.first = total;
     total += std::uint32_t(v.loops);
   }
+  auto index_of = [&](const Cell& c) -> std::optional<std::size_t> {
+    const std::uint64_t k = key(c);
+    const auto it = std::lower_bound(cells.begin(), cells.end(), k,
+                                     [](const Cell& a, std::uint64_t b) { return key(a) < b; });
+    if (it == cells.end() || key(*it) != k) return std::nullopt;
+    return std::size_t(it - cells.begin());
+  };
+  // Each grid edge the surface crosses, once: a cell finds the roots on the three edges from its
+  // lowest corner, which the up to four cells around each edge share.
+  std::vector<std::array<EdgePoint, 3>> roots(cells.size());
+  tbb::parallel_for(std::size_t{0}, cells.size(), [&](std::size_t i) {
+    if (loops[i].loops == 0) return;
+    for (int axis = 0; axis < 3; ++axis) {
+      const int e = edge_of(axis, 0, 0);
+      if (loops[i].vertex_of_edge[size_t(e)] < 0) continue;
+      roots[i][size_t(axis)] = edge_point(
+          tape, g.corner(cells[i]), g.corner(corner_of(cells[i], edge_corner(e, 1))), values[i][0]);
+    }
+  });
   TriangleMesh& mesh = out.mesh;
   mesh.positions.resize(total);
   mesh.normals.resize(total);
@@ -340,9 +358,15 @@ GridMesh mesh_grid(const Tape& tape, const Grid& g, double error) {
     for (int e = 0; e < 12; ++e) {
       const int loop = v.vertex_of_edge[size_t(e)];
       if (loop < 0) continue;
-      const int a = edge_corner(e, 0), b = edge_corner(e, 1);
-      points[size_t(loop)].push_back(edge_point(tape, g.corner(corner_of(c, a)),
-                                                g.corner(corner_of(c, b)), values[i][size_t(a)]));
+      // The edge's root, from the cell whose lowest corner the edge starts at (a cell around a
+      // crossed edge is always one of the cells: interval arithmetic cannot clear it).
+      const int a = edge_corner(e, 0);
+      const Cell owner = corner_of(c, a);
+      const auto k = owner == c ? std::optional<std::size_t>(i) : index_of(owner);
+      points[size_t(loop)].push_back(k ? roots[*k][size_t(e / 4)]
+                                       : edge_point(tape, g.corner(owner),
+                                                    g.corner(corner_of(c, edge_corner(e, 1))),
+                                                    values[i][size_t(a)]));
     }
     const Box box{g.corner(c), g.corner(corner_of(c, 7))};
     for (int loop = 0; loop < v.loops; ++loop) {
@@ -384,13 +408,6 @@ GridMesh mesh_grid(const Tape& tape, const Grid& g, double error) {
   for (const double e : vertex_error) out.vertex_error = std::max(out.vertex_error, e);
   // Faces: a quad around each grid edge with a sign change, of the four cells' loops there,
   // emitted by the cell at the edge's lowest position; counter-clockwise seen from outside.
-  auto index_of = [&](const Cell& c) -> std::optional<std::size_t> {
-    const std::uint64_t k = key(c);
-    const auto it = std::lower_bound(cells.begin(), cells.end(), k,
-                                     [](const Cell& a, std::uint64_t b) { return key(a) < b; });
-    if (it == cells.end() || key(*it) != k) return std::nullopt;
-    return std::size_t(it - cells.begin());
-  };
   std::vector<std::vector<std::array<std::uint32_t, 3>>> triangles(cells.size());
   tbb::parallel_for(std::size_t{0}, cells.size(), [&](std::size_t i) {
     const Cell& c = cells[i];
