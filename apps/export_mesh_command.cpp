@@ -4,7 +4,9 @@
 #include <fmt/format.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -29,7 +31,8 @@ struct MeshArgs {
   double error = 0;
   int object = -1;  // -1: every object
   bool all = false;
-  int threads = 0;  // 0: all cores
+  int threads = 0;                        // 0: all cores
+  std::optional<std::string> max_memory;  // none: the system's available memory
   std::vector<std::string> sets;
   bool quiet = false;
 };
@@ -37,7 +40,13 @@ struct MeshArgs {
 int run_export_mesh(const MeshArgs& args) {
   using namespace nimbus;
   const auto start = std::chrono::steady_clock::now();
+  std::uint64_t budget = 0;
   try {
+    try {
+      budget = args.max_memory ? parse_memory_size(*args.max_memory) : available_memory();
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(fmt::format("--max-memory: {}", e.what()));
+    }
     check_writable_path(args.output);
     if (!mesh_format(args.output))
       throw std::runtime_error(args.output + ": unknown mesh format (use .ply, .obj or .stl)");
@@ -72,11 +81,15 @@ int run_export_mesh(const MeshArgs& args) {
   TriangleMesh mesh;
   PolygonizeOptions options;
   options.error = args.error;
-  options.max_cells = available_memory() / kPolygonizeBytesPerCell;
   double vertex_error = 0, face_error = 0;
   int meshed = 0;
   for (const SceneObject& obj : scene.objects) {
     if (args.object >= 0 && obj.source != args.object) continue;
+    // The memory budget is the whole run's: each object gets what the meshes before it left.
+    const std::uint64_t used = mesh.positions.size() * 2 * sizeof(Vec3) +
+                               mesh.triangles.size() * sizeof(mesh.triangles[0]);
+    options.max_cells =
+        std::max<std::uint64_t>(1, (budget - std::min(budget, used)) / kPolygonizeBytesPerCell);
     PolygonizeReport report;
     try {
       append(mesh, polygonize(obj.tape, options, &report));
@@ -129,6 +142,9 @@ Command export_mesh_command(CLI::App& app) {
                                  "Index into the scene's objects (its instances included)")
                      ->check(integer_in(0));
   cmd->add_flag("--all", args->all, "Every object (the default)")->excludes(object);
+  cmd->add_option("--max-memory", args->max_memory,
+                  "Refuse error bounds whose meshing is estimated to need more memory than this "
+                  "(e.g. 8G, 512M; default: the system's available memory)");
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")
       ->check(integer_in(1));
   cmd->add_option("--set", args->sets, "Override a scene key, as for render; repeatable");

@@ -151,6 +151,9 @@ TEST_F(MeshCli, BadInputIsOneLineAndWritesNothing) {
       {"missing.json --error 0.01 -o out.ply", "missing.json"},
       {"empty.json --error 0.01 -o out.ply", "no object to mesh"},
       {"scene.json --error 1e-9 -o out.ply", "limit is"},
+      {"scene.json --error 0.002 --max-memory 64K -o out.ply",
+       "/objects/0: an error bound of 0.002"},
+      {"scene.json --error 0.002 --max-memory lots -o out.ply", "--max-memory: "},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.args);
