@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <iterator>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -19,6 +20,8 @@ namespace nimbus {
 namespace {
 
 static_assert(std::endian::native == std::endian::little, "the binary writers assume it");
+
+constexpr std::size_t kObjBlock = 1 << 20;  // bytes of OBJ text written at once
 
 struct FileCloser {
   void operator()(std::FILE* f) const { std::fclose(f); }
@@ -64,15 +67,28 @@ void write_ply(std::FILE* f, const TriangleMesh& m) {
 }
 
 void write_obj(std::FILE* f, const TriangleMesh& m) {
-  put_text(f, "# nimbus export-mesh\n");
-  std::string buf;
-  for (const Vec3& p : m.positions) buf += fmt::format("v {:.9g} {:.9g} {:.9g}\n", p.x, p.y, p.z);
-  for (const Vec3& n : m.normals) buf += fmt::format("vn {:.6g} {:.6g} {:.6g}\n", n.x, n.y, n.z);
-  put_text(f, buf);
-  buf.clear();
-  for (const auto& t : m.triangles)  // OBJ indices start at 1
-    buf += fmt::format("f {0}//{0} {1}//{1} {2}//{2}\n", t[0] + 1, t[1] + 1, t[2] + 1);
-  put_text(f, buf);
+  // Lines go out in blocks of about a megabyte: the text is never held whole.
+  fmt::memory_buffer buf;
+  auto flush = [&](std::size_t above) {
+    if (buf.size() < above) return;
+    put(f, buf.data(), buf.size());
+    buf.clear();
+  };
+  fmt::format_to(std::back_inserter(buf), "# nimbus export-mesh\n");
+  for (const Vec3& p : m.positions) {
+    fmt::format_to(std::back_inserter(buf), "v {:.9g} {:.9g} {:.9g}\n", p.x, p.y, p.z);
+    flush(kObjBlock);
+  }
+  for (const Vec3& n : m.normals) {
+    fmt::format_to(std::back_inserter(buf), "vn {:.6g} {:.6g} {:.6g}\n", n.x, n.y, n.z);
+    flush(kObjBlock);
+  }
+  for (const auto& t : m.triangles) {  // OBJ indices start at 1
+    fmt::format_to(std::back_inserter(buf), "f {0}//{0} {1}//{1} {2}//{2}\n", t[0] + 1, t[1] + 1,
+                   t[2] + 1);
+    flush(kObjBlock);
+  }
+  flush(0);
 }
 
 void write_stl(std::FILE* f, const TriangleMesh& m) {
