@@ -1,4 +1,4 @@
-// `nimbus export-mesh SCENE -o OUT.{ply,obj,stl} --error E`: the scene's objects as a triangle
+// `nimbus export-mesh SCENE -o OUT.{ply,obj,stl,glb} --error E`: the scene's objects as a triangle
 // mesh to an error bound (mesh/polygonize.h, io/mesh_file.h).
 
 #include <fmt/format.h>
@@ -49,7 +49,8 @@ int run_export_mesh(const MeshArgs& args) {
     }
     check_writable_path(args.output);
     if (!mesh_format(args.output))
-      throw std::runtime_error(args.output + ": unknown mesh format (use .ply, .obj or .stl)");
+      throw std::runtime_error(args.output +
+                               ": unknown mesh format (use .ply, .obj, .stl or .glb)");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "nimbus: %s\n", e.what());
     return kExitBadInput;
@@ -132,7 +133,9 @@ Command export_mesh_command(CLI::App& app) {
       "export-mesh",
       "Write the scene's objects as a triangle mesh to an error bound (docs/cli.md)");
   cmd->add_option("scene", args->scene, "Scene file (JSON)")->required();
-  cmd->add_option("-o,--output", args->output, "Output file (.ply, .obj or .stl)")->required();
+  cmd->add_option("-o,--output", args->output,
+                  "Output file (.ply, .obj, .stl or .glb: glTF 2.0 binary)")
+      ->required();
   cmd->add_option("--error", args->error,
                   "Error bound E > 0 in scene units: every vertex within E of the surface, every "
                   "face's sample points within E")

@@ -1,6 +1,6 @@
-// `nimbus export-mesh` (issue 43), run as a program: PLY, OBJ and STL files of one mesh agree,
-// the objects keep their transforms and instances, and bad input exits 2 with one line and
-// writes nothing.
+// `nimbus export-mesh` (issue 43), run as a program: PLY, OBJ, STL and glTF binary files of one
+// mesh agree, the objects keep their transforms and instances, and bad input exits 2 with one
+// line and writes nothing.
 
 #include <gtest/gtest.h>
 
@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -82,9 +83,9 @@ nimbus::TriangleMesh read_ply(const std::string& path) {
   return m;
 }
 
-TEST_F(MeshCli, ThreeFormatsOfOneClosedMeshWithTransformsAndInstances) {
+TEST_F(MeshCli, FourFormatsOfOneClosedMeshWithTransformsAndInstances) {
   write("scene.json", kScene);
-  for (const char* out : {"out.ply", "out.obj", "out.stl"}) {
+  for (const char* out : {"out.ply", "out.obj", "out.stl", "out.glb"}) {
     const Ran r = run(std::string("export-mesh scene.json --error 0.002 -q -o ") + out);
     ASSERT_EQ(r.code, 0) << r.err;
   }
@@ -123,6 +124,26 @@ TEST_F(MeshCli, ThreeFormatsOfOneClosedMeshWithTransformsAndInstances) {
   stl.read(reinterpret_cast<char*>(&count), 4);
   EXPECT_EQ(count, m.triangles.size());
   EXPECT_EQ(fs::file_size(file("out.stl")), 84 + 50 * std::uintmax_t(count));
+  // The GLB's accessors count the PLY's vertices and indices, and its BIN chunk ends with the
+  // PLY's triangles (mesh_test.cpp reads the whole layout).
+  std::ifstream glb_in(file("out.glb"), std::ios::binary);
+  const std::string glb{std::istreambuf_iterator<char>(glb_in), {}};
+  ASSERT_GE(glb.size(), 28u);
+  std::uint32_t glb_header[5];
+  std::memcpy(glb_header, glb.data(), sizeof glb_header);
+  EXPECT_EQ(glb.substr(0, 4), "glTF");
+  EXPECT_EQ(glb_header[2], glb.size());
+  const nlohmann::json doc = nlohmann::json::parse(glb.substr(20, glb_header[3]));
+  const nlohmann::json& primitive = doc["meshes"][0]["primitives"][0];
+  const auto count_of = [&](const nlohmann::json& accessor) {
+    return doc["accessors"][accessor.get<std::size_t>()]["count"].get<std::size_t>();
+  };
+  EXPECT_EQ(count_of(primitive["attributes"]["POSITION"]), m.positions.size());
+  EXPECT_EQ(count_of(primitive["attributes"]["NORMAL"]), m.positions.size());
+  EXPECT_EQ(count_of(primitive["indices"]), 3 * m.triangles.size());
+  const std::size_t index_bytes = m.triangles.size() * sizeof m.triangles[0];
+  ASSERT_GE(glb.size(), index_bytes);
+  EXPECT_EQ(std::memcmp(glb.data() + glb.size() - index_bytes, m.triangles.data(), index_bytes), 0);
   // The same bytes on one thread.
   ASSERT_EQ(run("export-mesh scene.json --error 0.002 --threads 1 -q -o one.ply").code, 0);
   std::ifstream a(file("out.ply"), std::ios::binary), b(file("one.ply"), std::ios::binary);
@@ -145,8 +166,8 @@ TEST_F(MeshCli, BadInputIsOneLineAndWritesNothing) {
   } cases[] = {
       {"scene.json --error 0 -o out.ply", "--error: must be > 0, not 0"},
       {"scene.json --error -1 -o out.ply", "must be > 0"},
-      {"scene.json --error 0.01 -o out.glb",
-       "out.glb: unknown mesh format (use .ply, .obj or .stl)"},
+      {"scene.json --error 0.01 -o out.gltf",
+       "out.gltf: unknown mesh format (use .ply, .obj, .stl or .glb)"},
       {"scene.json --error 0.01 --object 5 -o out.ply", "--object 5: the scene has 2 objects"},
       {"missing.json --error 0.01 -o out.ply", "missing.json"},
       {"empty.json --error 0.01 -o out.ply", "no object to mesh"},

@@ -1,23 +1,34 @@
 // Polygonization (mesh/polygonize.h): quadrics mesh to their analytic volume and area; every
 // vertex lies within ε of the exact surface and every surface point within 2ε of the mesh; the
 // mesh is a closed 2-manifold of the shape's Euler characteristic and components; a thin
-// free-form spike keeps its tip, and the mesh is the same for any thread count.
+// free-form spike keeps its tip, and the mesh is the same for any thread count. A glTF binary
+// file (io/mesh_file.h) read back by the spec's layout holds the mesh's own bytes and bounds.
 
 #include "nimbus/mesh/mesh.h"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "nimbus/frep/intersect.h"
+#include "nimbus/io/mesh_file.h"
 #include "nimbus/math/constants.h"
 #include "nimbus/math/rng.h"
 #include "nimbus/mesh/polygonize.h"
 #include "nimbus/render/sampling.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
+#include "support/process.h"
 
 namespace nimbus {
 namespace {
@@ -212,6 +223,129 @@ TEST(Polygonize, RefusesABadErrorBoundAndATooFineGrid) {
   } catch (const PolygonizeError& e) {
     EXPECT_NE(std::string(e.what()).find("limit is 10000"), std::string::npos) << e.what();
   }
+}
+
+std::uint32_t glb_u32(const std::string& bytes, std::size_t at) {
+  std::uint32_t v = 0;
+  std::memcpy(&v, bytes.data() + at, sizeof v);
+  return v;
+}
+
+template <class T>
+std::string bytes_of(const std::vector<T>& v) {
+  return std::string(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+}
+
+// Read back by the GLB layout of the glTF 2.0 spec alone, not by nimbus's writer: the header and
+// both chunks, the JSON's scene, mesh and accessors, and each accessor's bytes against the mesh.
+TEST(MeshFile, GlbHoldsTheMeshBytesAndBounds) {
+  const TriangleMesh mesh = polygonize(
+      tape_of(R"({"type": "ellipsoid", "center": [0.3, -1, 2], "radii": [1, 0.6, 0.4]})"),
+      {1e-2, 0});
+  ASSERT_FALSE(mesh.triangles.empty());
+  EXPECT_EQ(mesh_format("some/Ball.GLB"), MeshFormat::Glb);
+  const std::filesystem::path dir = test::fresh_test_dir("nimbus_mesh_file");
+  write_mesh((dir / "ball.Glb").string(), mesh);
+  EXPECT_THROW(write_mesh((dir / "empty.glb").string(), TriangleMesh{}), std::runtime_error);
+  std::vector<std::string> names;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    names.push_back(e.path().filename().string());
+  EXPECT_EQ(names, std::vector<std::string>{"ball.Glb"});  // no temporary left, no empty file
+  std::ifstream in(dir / "ball.Glb", std::ios::binary);
+  const std::string file{std::istreambuf_iterator<char>(in), {}};
+  std::filesystem::remove_all(dir);
+
+  ASSERT_GE(file.size(), 28u);
+  EXPECT_EQ(file.substr(0, 4), "glTF");
+  EXPECT_EQ(glb_u32(file, 4), 2u);
+  EXPECT_EQ(glb_u32(file, 8), file.size());
+  const std::uint32_t json_length = glb_u32(file, 12);
+  EXPECT_EQ(file.substr(16, 4), "JSON");
+  EXPECT_EQ(json_length % 4, 0u);
+  const std::size_t bin_at = 20 + std::size_t(json_length);
+  ASSERT_LE(bin_at + 8, file.size());
+  const std::uint32_t bin_length = glb_u32(file, bin_at);
+  EXPECT_EQ(file.substr(bin_at + 4, 4), std::string("BIN\0", 4));
+  EXPECT_EQ(bin_length % 4, 0u);
+  ASSERT_EQ(bin_at + 8 + bin_length, file.size());
+  const std::string text = file.substr(20, json_length);
+  const std::string bin = file.substr(bin_at + 8);
+  // Padded with spaces after the closing brace, fewer than four.
+  const std::size_t last = text.find_last_not_of(' ');
+  ASSERT_NE(last, std::string::npos);
+  EXPECT_EQ(text[last], '}');
+  EXPECT_LT(text.size() - 1 - last, 4u);
+
+  const nlohmann::json doc = nlohmann::json::parse(text);
+  EXPECT_EQ(doc.at("asset").at("version"), "2.0");
+  EXPECT_EQ(doc.at("asset").at("generator"), "nimbus");
+  EXPECT_EQ(doc.at("scene"), 0);
+  EXPECT_EQ(doc.at("scenes"), nlohmann::json::parse(R"([{"nodes": [0]}])"));
+  EXPECT_EQ(doc.at("nodes"), nlohmann::json::parse(R"([{"mesh": 0}])"));
+  ASSERT_EQ(doc.at("meshes").size(), 1u);
+  ASSERT_EQ(doc.at("meshes").at(0).at("primitives").size(), 1u);
+  const nlohmann::json& primitive = doc.at("meshes").at(0).at("primitives").at(0);
+  EXPECT_EQ(primitive.at("mode"), 4);  // triangles
+  ASSERT_EQ(doc.at("buffers").size(), 1u);
+  const std::size_t buffer_length = doc.at("buffers").at(0).at("byteLength");
+  EXPECT_LE(buffer_length, bin.size());
+  EXPECT_LT(bin.size() - buffer_length, 4u);
+
+  // An accessor's tightly packed bytes in BIN, its view and type checked on the way.
+  const auto accessor_bytes = [&](const nlohmann::json& index, int component_type,
+                                  const std::string& type, std::size_t count, int target) {
+    const nlohmann::json& a = doc.at("accessors").at(index.get<std::size_t>());
+    EXPECT_EQ(a.at("componentType"), component_type);
+    EXPECT_EQ(a.at("type"), type);
+    EXPECT_EQ(a.at("count"), count);
+    const nlohmann::json& v = doc.at("bufferViews").at(a.at("bufferView").get<std::size_t>());
+    EXPECT_EQ(v.at("buffer"), 0);
+    EXPECT_EQ(v.at("target"), target);
+    EXPECT_FALSE(v.contains("byteStride"));
+    const std::size_t view_at = v.value("byteOffset", std::size_t{0});
+    const std::size_t at = view_at + a.value("byteOffset", std::size_t{0});
+    const std::size_t bytes = count * 4 * (type == "VEC3" ? 3 : 1);
+    EXPECT_EQ(at % 4, 0u);
+    EXPECT_LE(at + bytes, view_at + v.at("byteLength").get<std::size_t>());
+    EXPECT_LE(view_at + v.at("byteLength").get<std::size_t>(), buffer_length);
+    return bin.substr(at, bytes);
+  };
+  std::vector<float> positions, normals;
+  std::array<float, 3> lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
+  for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+    const Vec3 &p = mesh.positions[i], &n = mesh.normals[i];
+    const float pf[3] = {float(p.x), float(p.y), float(p.z)};
+    for (int k = 0; k < 3; ++k) {
+      positions.push_back(pf[k]);
+      lo[k] = std::min(lo[k], pf[k]);
+      hi[k] = std::max(hi[k], pf[k]);
+    }
+    normals.insert(normals.end(), {float(n.x), float(n.y), float(n.z)});
+  }
+  const std::size_t vertices = mesh.positions.size();
+  const nlohmann::json& attributes = primitive.at("attributes");
+  // Compared with EXPECT_TRUE: a failure would otherwise print megabytes. The normals written
+  // are the ones checked for unit length below.
+  EXPECT_TRUE(accessor_bytes(attributes.at("POSITION"), 5126, "VEC3", vertices, 34962) ==
+              bytes_of(positions));
+  EXPECT_TRUE(accessor_bytes(attributes.at("NORMAL"), 5126, "VEC3", vertices, 34962) ==
+              bytes_of(normals));
+  for (std::size_t i = 0; i + 2 < normals.size(); i += 3)
+    ASSERT_NEAR(std::hypot(normals[i], normals[i + 1], normals[i + 2]), 1, 1e-6) << i / 3;
+  EXPECT_TRUE(accessor_bytes(primitive.at("indices"), 5125, "SCALAR", 3 * mesh.triangles.size(),
+                             34963) == bytes_of(mesh.triangles));
+  // POSITION's required bounds are exactly the written floats', read as doubles: no rounding
+  // hides a bound off by less than a float's step.
+  const nlohmann::json& position =
+      doc.at("accessors").at(attributes.at("POSITION").get<std::size_t>());
+  ASSERT_EQ(position.at("min").size(), 3u);
+  ASSERT_EQ(position.at("max").size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(position.at("min").at(k).get<double>(), double(lo[k])) << k;
+    EXPECT_EQ(position.at("max").at(k).get<double>(), double(hi[k])) << k;
+  }
+  EXPECT_NEAR(lo[0], -0.7, 0.02);  // the ellipsoid's own box, within 2ε
+  EXPECT_NEAR(hi[2], 2.4, 0.02);
 }
 
 }  // namespace
