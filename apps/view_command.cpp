@@ -36,6 +36,7 @@ struct ViewArgs {
   int threads = 0;
   std::optional<std::string> max_memory;
   bool allow_remote = false;
+  double mesh_error = 1.0 / 256;
 };
 
 // Ends `nimbus view` once a signal has come: stops the server at once, and ends the process
@@ -93,6 +94,14 @@ int run_view(const ViewArgs& args) {
   options.spp = args.spp;
   options.seed = args.seed;
   options.threads = args.threads;
+  if (!(args.mesh_error >= 0 && args.mesh_error <= 0.25)) {
+    std::fprintf(stderr,
+                 "nimbus: --mesh-error: must be in [0, 0.25] (a fraction of each object's size; "
+                 "0: no meshes), not %g\n",
+                 args.mesh_error);
+    return kExitBadInput;
+  }
+  options.mesh_error = args.mesh_error;
   if (args.max_memory) {
     try {
       options.max_memory = parse_memory_size(*args.max_memory);
@@ -165,5 +174,8 @@ Command view_command(CLI::App& app) {
   view->add_option("--set", args->sets, "Override a scene key, as for render; repeatable");
   view->add_option("--max-memory", args->max_memory,
                    "Refuse scenes estimated to need more memory than this (as for render)");
+  view->add_option("--mesh-error", args->mesh_error,
+                   "Error of the meshes the page draws while the camera moves, as a fraction of "
+                   "each object's size (default 1/256; 0: no meshes, the server's preview only)");
   return {view, [args](const Cluster&) { return run_view(*args); }, /*stoppable=*/true};
 }

@@ -1,6 +1,7 @@
 // nimbus view's parts below the web server (issue 28): the preview against closed forms, the
 // session's film against render()'s bits after a camera move, reloads and a broken file keeping
-// the last image, the noise figure, PNG bytes in memory, and the camera's messages.
+// the last image, the noise figure, PNG bytes in memory, and the camera's messages; the page's
+// meshes (issue 43): their binary, their error, and an edit re-meshing only what it touched.
 
 #include <arpa/inet.h>
 #include <fmt/format.h>
@@ -9,12 +10,15 @@
 #include <sys/stat.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 
 #include "nimbus/io/film_image.h"
 #include "nimbus/io/png.h"
+#include "nimbus/mesh/polygonize.h"
 #include "nimbus/render/renderer.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/json_reader.h"
@@ -23,6 +27,7 @@
 #include "nimbus/view/connection_table.h"
 #include "nimbus/view/loopback.h"
 #include "nimbus/view/preview.h"
+#include "nimbus/view/preview_mesh.h"
 #include "nimbus/view/view_session.h"
 #include "support/process.h"
 
@@ -240,6 +245,159 @@ TEST(Preview, ADiffuseSurfaceFacingTheEyeShowsItsAlbedo) {
   EXPECT_FLOAT_EQ(image.rgb[corner], 0.25f);  // the sky
   EXPECT_EQ(preview_downscale(1920, 1080, 1 << 16), 6);
   EXPECT_EQ(preview_downscale(160, 120, 1 << 16), 1);
+}
+
+// The page's mesh binary read back as meshes.js reads it (view/preview_mesh.h).
+struct DecodedMeshes {
+  Vec3 background;
+  Box bounds;
+  struct Object {
+    float colour[4];
+    TriangleMesh mesh;
+  };
+  std::vector<Object> objects;
+};
+
+DecodedMeshes decode_meshes(const std::string& bytes) {
+  size_t at = 0;
+  const auto u32 = [&] {
+    std::uint32_t v;
+    std::memcpy(&v, bytes.data() + at, 4);
+    at += 4;
+    return v;
+  };
+  const auto f32 = [&] {
+    float v;
+    std::memcpy(&v, bytes.data() + at, 4);
+    at += 4;
+    return double(v);
+  };
+  const auto vec = [&] {
+    const double x = f32(), y = f32(), z = f32();
+    return Vec3{x, y, z};
+  };
+  DecodedMeshes d;
+  EXPECT_EQ(bytes.substr(0, 4), "NMSH");
+  at = 4;
+  EXPECT_EQ(u32(), 1u);
+  const std::uint32_t count = u32();
+  d.background = vec();
+  d.bounds.lo = vec();
+  d.bounds.hi = vec();
+  for (std::uint32_t i = 0; i < count; ++i) {
+    DecodedMeshes::Object o;
+    for (float& c : o.colour) c = float(f32());
+    const std::uint32_t vertices = u32(), triangles = u32();
+    for (std::uint32_t v = 0; v < vertices; ++v) o.mesh.positions.push_back(vec());
+    for (std::uint32_t v = 0; v < vertices; ++v) o.mesh.normals.push_back(vec());
+    for (std::uint32_t t = 0; t < triangles; ++t) o.mesh.triangles.push_back({u32(), u32(), u32()});
+    d.objects.push_back(std::move(o));
+  }
+  EXPECT_EQ(at, bytes.size());
+  return d;
+}
+
+std::string meshes_scene(double radius, const std::string& albedo) {
+  return fmt::format(R"({{
+    "film": {{"width": 16, "height": 12}},
+    "camera": {{"from": [0, 1, 8], "to": [0, 0, 0], "fov": 35}},
+    "integrator": {{"spp": 4}},
+    "lights": [{{"type": "environment", "radiance": [0.2, 0.3, 0.4]}}],
+    "media": {{"fog": {{"sigma_a": 0.2, "sigma_s": [0.8, 0.3, 0.8]}}}},
+    "objects": [
+      {{"shape": {{"type": "sphere", "center": [-1.5, 0, 0], "radius": {}}},
+        "surface": {{"type": "diffuse", "albedo": {}}}}},
+      {{"shape": {{"type": "box", "min": [0.5, -1, -1], "max": [2.5, 1, 1]}},
+        "surface": {{"type": "conductor", "eta": [0.2, 0.9, 1.1], "k": [3.9, 2.4, 2.2]}}}},
+      {{"shape": {{"type": "ellipsoid", "center": [0, 2, 0], "radii": [1, 0.5, 0.5]}},
+        "surface": {{"type": "none"}}, "medium": "fog"}}]
+  }})",
+                     radius, albedo);
+}
+
+TEST(PreviewMeshes, AreTheObjectsClosedWithinTheirErrorInTheirColours) {
+  const Scene scene = compile_scene(load_scene_text(meshes_scene(1, "[0.7, 0.5, 0.3]"), "m"));
+  PreviewMesher mesher;
+  PreviewMeshStats stats;
+  const DecodedMeshes d = decode_meshes(mesher.update(preview_scene(scene), &stats));
+  EXPECT_EQ(stats.meshed, 3);
+  EXPECT_EQ(stats.reused, 0);
+  ASSERT_EQ(d.objects.size(), 3u);
+  EXPECT_DOUBLE_EQ(d.background.z, double(0.4f));
+  // The diffuse sphere in its albedo; the metal at its normal-incidence reflectance
+  // ((η − 1)² + k²) / ((η + 1)² + k²); the medium's hull see-through, in σ_s / σ_t.
+  EXPECT_FLOAT_EQ(d.objects[0].colour[0], 0.7f);
+  EXPECT_FLOAT_EQ(d.objects[0].colour[3], 1.0f);
+  EXPECT_NEAR(d.objects[1].colour[0], (0.64 + 3.9 * 3.9) / (1.44 + 3.9 * 3.9), 1e-6);
+  EXPECT_NEAR(d.objects[2].colour[1], 0.3 / 0.5, 1e-6);
+  EXPECT_LT(d.objects[2].colour[3], 1.0f);
+  std::uint64_t triangles = 0;
+  for (size_t i = 0; i < 3; ++i) {
+    const TriangleMesh& m = d.objects[i].mesh;
+    triangles += m.triangles.size();
+    const MeshTopology t = mesh_topology(m);
+    EXPECT_TRUE(t.manifold) << "object " << i;
+    EXPECT_EQ(t.euler, 2) << "object " << i;
+    // Every vertex within the preview's error of the surface: 1/256 of the object's size, the
+    // floats' rounding aside (exact distances for the sphere; the bounds for the others).
+    const Box& b = scene.objects[i].bounds;
+    const Vec3 e = b.extent();
+    const double eps = std::max({e.x, e.y, e.z}) / 256 + 1e-5;
+    for (const Vec3& p : m.positions) {
+      if (i == 0) {
+        EXPECT_LE(std::abs(length(p - Vec3{-1.5, 0, 0}) - 1), eps);
+      }
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_GE(p[k], b.lo[k] - eps);
+        EXPECT_LE(p[k], b.hi[k] + eps);
+      }
+    }
+  }
+  EXPECT_EQ(stats.triangles, triangles);
+  EXPECT_NEAR(d.bounds.lo.x, -2.5, 0.01);
+  EXPECT_NEAR(d.bounds.hi.y, 2.5, 0.01);
+}
+
+TEST(PreviewMeshes, AnEditReMeshesOnlyTheObjectsItChanged) {
+  PreviewMesher mesher;
+  PreviewMeshStats stats;
+  const auto meshes = [&](double radius, const std::string& albedo) {
+    return decode_meshes(mesher.update(
+        preview_scene(compile_scene(load_scene_text(meshes_scene(radius, albedo), "m"))), &stats));
+  };
+  const DecodedMeshes first = meshes(1, "0.5");
+  // A colour is no reason to mesh again.
+  const DecodedMeshes recoloured = meshes(1, "[0.1, 0.9, 0.1]");
+  EXPECT_EQ(stats.meshed, 0);
+  EXPECT_EQ(stats.reused, 3);
+  EXPECT_FLOAT_EQ(recoloured.objects[0].colour[1], 0.9f);
+  EXPECT_EQ(recoloured.objects[0].mesh.positions, first.objects[0].mesh.positions);
+  // A new radius is: that sphere alone.
+  const DecodedMeshes grown = meshes(1.2, "0.5");
+  EXPECT_EQ(stats.meshed, 1);
+  EXPECT_EQ(stats.reused, 2);
+  EXPECT_NE(grown.objects[0].mesh.positions, first.objects[0].mesh.positions);
+  EXPECT_EQ(grown.objects[1].mesh.positions, first.objects[1].mesh.positions);
+  EXPECT_NEAR(enclosed_volume(grown.objects[0].mesh), 4 * std::numbers::pi * 1.2 * 1.2 * 1.2 / 3,
+              0.02);
+}
+
+TEST_F(Session, MeshesEachSceneItLoads) {
+  write(meshes_scene(1, "0.5"));
+  ViewSession session(options());
+  ASSERT_TRUE(session.wait([](const ViewFrame& f) { return f.mesh_version == 1; }, 60));
+  EXPECT_EQ(session.frame().mesh_stats.meshed, 3);
+  EXPECT_EQ(decode_meshes(*session.frame().meshes).objects.size(), 3u);
+  write(meshes_scene(0.8, "0.5"));
+  ASSERT_TRUE(session.wait([](const ViewFrame& f) { return f.mesh_version == 2; }, 60));
+  EXPECT_EQ(session.frame().mesh_stats.meshed, 1);
+  EXPECT_EQ(session.frame().mesh_stats.reused, 2);
+
+  ViewOptions none = options();
+  none.mesh_error = 0;
+  ViewSession without(none);
+  ASSERT_TRUE(without.wait(done, 60));
+  EXPECT_EQ(without.frame().meshes, nullptr);
 }
 
 TEST(EncodePng, IsTheBytesWritePngWrites) {

@@ -308,6 +308,9 @@ def test_bad_command_lines(tmp_path):
         assert code == 2 and err.count("\n") == 1 and "cannot listen" in err
     code, err = run(path, "--port", "70000")
     assert code == 2 and err.count("\n") == 1
+    for bad in ("-0.1", "0.5", "nan"):
+        code, err = run(path, "--port", "0", "--mesh-error", bad)
+        assert code == 2 and err.count("\n") == 1 and err.startswith("nimbus: --mesh-error: "), err
     # Beyond the loopback only when asked, and then said (issue 44).
     code, err = run(path, "--host", "0.0.0.0", "--port", "0")
     assert code == 2 and err.count("\n") == 1 and "not a loopback address" in err

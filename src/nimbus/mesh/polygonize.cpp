@@ -21,8 +21,6 @@ namespace {
 // Grid corners sit off the round coordinates shapes are usually placed at: a shift of this many
 // cells, (3 − √5) / 2.
 constexpr double kGridShift = 0.3819660112501051;
-// The first grid has this many cells across the shape's largest extent.
-constexpr int kFirstCells = 16;
 // At most this many cells along an axis (a cell's key packs 21 bits per axis).
 constexpr int kMaxAxisCells = (1 << 21) - 2;
 // A cell whose corners share a sign is searched for a hidden piece of the shape down to boxes
@@ -501,7 +499,7 @@ TriangleMesh polygonize(const Tape& tape, const PolygonizeOptions& options,
   const Vec3 extent = bounds.extent();
   const double size = std::max({extent.x, extent.y, extent.z});
   PolygonizeReport r;
-  double h = size / kFirstCells;
+  double h = size / std::max(options.first_cells, 1);
   std::uint64_t previous_cells = 0;
   for (;;) {
     Grid g;

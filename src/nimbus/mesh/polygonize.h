@@ -24,6 +24,9 @@ inline constexpr std::uint64_t kPolygonizeBytesPerCell = 320;
 struct PolygonizeOptions {
   double error = 0;             // ε > 0, scene units
   std::uint64_t max_cells = 0;  // refuse a grid estimated to need more surface cells; 0: no limit
+  // Cells across the shape's largest extent in the first grid, which is refined from there: a
+  // coarse preview of many small objects starts coarser.
+  int first_cells = 16;
 };
 
 struct PolygonizeReport {

@@ -146,7 +146,10 @@ struct ViewServer::Impl {
             {"error", f.error},
             {"loads", f.loads},
             {"restarts", f.restarts},
-            {"camera", camera_json(f.camera)}};
+            {"camera", camera_json(f.camera)},
+            {"meshes", f.mesh_version},
+            {"mesh_triangles", f.mesh_stats.triangles},
+            {"mesh_seconds", f.mesh_seconds}};
   }
 
   // The film's image, written as `nimbus render` writes it, through a private temporary file.
@@ -198,6 +201,8 @@ struct ViewServer::Impl {
     if (get && url == "/") return Answer{200, kViewerHtml, "text/html; charset=utf-8", {}};
     if (get && url == "/viewer.js")
       return Answer{200, kViewerJs, "text/javascript; charset=utf-8", {}};
+    if (get && url == "/meshes.js")
+      return Answer{200, kViewerMeshesJs, "text/javascript; charset=utf-8", {}};
     if (get && url == "/viewer.css") return Answer{200, kViewerCss, "text/css; charset=utf-8", {}};
     if (get && url == "/state") return Answer{200, state().dump(), "application/json", {}};
     if (get && url == "/image.png") {
@@ -205,6 +210,14 @@ struct ViewServer::Impl {
       if (!f.image) return error(404, "no image yet");
       return Answer{
           200, image_png(f), "image/png", {{"X-Nimbus-Version", std::to_string(f.version)}}};
+    }
+    if (get && url == "/meshes.bin") {
+      const ViewFrame f = session.frame();
+      if (!f.meshes) return error(404, "no meshes yet");
+      return Answer{200,
+                    *f.meshes,
+                    "application/octet-stream",
+                    {{"X-Nimbus-Meshes", std::to_string(f.mesh_version)}}};
     }
     if (get && url == "/save.exr") return save("exr");
     if (get && url == "/save.png") return save("png");

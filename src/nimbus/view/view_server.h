@@ -1,5 +1,5 @@
 #pragma once
-// `nimbus view`'s web server (GNU libmicrohttpd, event-driven): the viewer page and its two
+// `nimbus view`'s web server (GNU libmicrohttpd, event-driven): the viewer page and its three
 // assets, the session's state as JSON, its image as PNG, camera moves, and the film saved as EXR
 // or PNG, and nothing else: no file of the file system is served. Connections cost a socket, not
 // a thread: a few threads watch them all (epoll) and run the handlers. Each request is small
@@ -10,9 +10,11 @@
 // render or the other clients.
 //
 //   GET  /                 the page          GET  /state       the frame as JSON
-//   GET  /viewer.js, /viewer.css             GET  /image.png   the image shown now
+//   GET  /viewer.js, /meshes.js, /viewer.css GET  /image.png   the image shown now
 //   POST /camera           {"from": ..., "to": ..., ...} (a scene file's camera), JSON only
 //   GET  /save.exr, /save.png                the film's image as `nimbus render` writes it
+//   GET  /meshes.bin       the objects' meshes, which the page draws while the camera moves
+//                          (view/preview_mesh.h)
 
 #include <memory>
 #include <string>
@@ -52,6 +54,7 @@ class ViewServer {
 // The page and its assets, compiled in (view/page/).
 extern const char* const kViewerHtml;
 extern const char* const kViewerJs;
+extern const char* const kViewerMeshesJs;
 extern const char* const kViewerCss;
 
 }  // namespace nimbus

@@ -41,6 +41,7 @@ double view_noise(const Film& film) {
 
 ViewSession::ViewSession(ViewOptions options) : options_(std::move(options)) {
   if (!load()) throw SceneError(frame_.error);
+  if (options_.mesh_error > 0) mesh_thread_ = std::thread([this] { mesh_loop(); });
   thread_ = std::thread([this] { loop(); });
 }
 
@@ -51,7 +52,9 @@ ViewSession::~ViewSession() {
   }
   interrupt_ = true;
   wake_.notify_all();
+  mesh_wake_.notify_all();
   if (thread_.joinable()) thread_.join();
+  if (mesh_thread_.joinable()) mesh_thread_.join();
 }
 
 ViewFrame ViewSession::frame() const {
@@ -125,6 +128,10 @@ bool ViewSession::load() {
     std::lock_guard lock(mutex_);
     frame_.error.clear();
     ++frame_.loads;
+    if (options_.mesh_error > 0) {
+      pending_meshes_ = preview_scene(*scene_);
+      mesh_wake_.notify_all();
+    }
   } catch (const std::exception& e) {
     watched_ = std::move(watched);
     std::lock_guard lock(mutex_);
@@ -198,6 +205,35 @@ void ViewSession::render_pass() {
       std::clamp(int(pass_spp_ * kPassSeconds / std::max(stats.seconds, 1e-3)), 1, 2 * pass_spp_);
   // With the scene's AOVs (film.aov), as `nimbus render` writes them: the saved EXR has them.
   publish(std::make_shared<Image>(to_image(film_, scene_->settings.aovs)), false);
+}
+
+void ViewSession::mesh_loop() {
+  PreviewMeshOptions mo;
+  mo.relative_error = options_.mesh_error;
+  PreviewMesher mesher(mo);
+  // As many threads as the render: the meshes make the page responsive, which matters more than
+  // the path tracer's first seconds, and meshing is over in seconds.
+  tbb::task_arena arena(options_.threads > 0 ? options_.threads : tbb::task_arena::automatic);
+  for (;;) {
+    PreviewScene scene;
+    {
+      std::unique_lock lock(mutex_);
+      mesh_wake_.wait(lock, [&] { return stop_ || pending_meshes_.has_value(); });
+      if (stop_) return;
+      scene = std::move(*pending_meshes_);
+      pending_meshes_.reset();
+    }
+    const auto start = Clock::now();
+    PreviewMeshStats stats;
+    auto meshes = std::make_shared<const std::string>(
+        arena.execute([&] { return mesher.update(scene, &stats); }));
+    std::lock_guard lock(mutex_);
+    frame_.meshes = std::move(meshes);
+    ++frame_.mesh_version;
+    frame_.mesh_stats = stats;
+    frame_.mesh_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    changed_.notify_all();
+  }
 }
 
 void ViewSession::loop() {

@@ -26,6 +26,7 @@
 #include "nimbus/render/film.h"
 #include "nimbus/render/scene.h"
 #include "nimbus/scene/scene_desc.h"
+#include "nimbus/view/preview_mesh.h"
 
 namespace nimbus {
 
@@ -39,6 +40,9 @@ struct ViewOptions {
   double watch_interval = 0.25;        // seconds between looks at the scene's files
   double rest = 0.2;                   // seconds the camera rests before the path tracer starts
   int preview_pixels = 1 << 16;        // a preview's pixel budget (preview_downscale)
+  // The page's meshes (view/preview_mesh.h): their error as a fraction of each object's size;
+  // 0: none.
+  double mesh_error = 1.0 / 256;
 };
 
 // What the page shows, as of one moment.
@@ -57,6 +61,12 @@ struct ViewFrame {
   uint64_t loads = 0;     // successful loads of the scene file
   uint64_t restarts = 0;  // camera moves and loads that restarted the render
   CameraDesc camera;      // the view rendered
+  // The objects' meshes for the page (view/preview_mesh.h), null until the first scene is
+  // meshed; mesh_version counts the scenes meshed.
+  std::shared_ptr<const std::string> meshes;
+  uint64_t mesh_version = 0;
+  PreviewMeshStats mesh_stats;  // of the last meshing
+  double mesh_seconds = 0;      // how long it took
 };
 
 class ViewSession {
@@ -89,6 +99,8 @@ class ViewSession {
   };
 
   void loop();
+  // The mesher's thread: meshes each scene loaded, the newest replacing any waiting.
+  void mesh_loop();
   // Loads and compiles the scene file; false (with the error published) if it fails.
   bool load();
   bool files_changed() const;
@@ -118,8 +130,10 @@ class ViewSession {
   std::optional<CameraDesc> pending_camera_;
   bool stop_ = false;
   ViewFrame frame_;
-  std::atomic<bool> interrupt_{false};  // stop, or a camera is pending: cancels a pass
-  std::thread thread_;
+  std::atomic<bool> interrupt_{false};          // stop, or a camera is pending: cancels a pass
+  std::optional<PreviewScene> pending_meshes_;  // a scene loaded and not yet meshed
+  std::condition_variable mesh_wake_;           // a scene to mesh, or stop
+  std::thread thread_, mesh_thread_;
 };
 
 // The noise of a film as one number: over pixels, the root mean square of the standard error of

@@ -1,5 +1,7 @@
 // nimbus view's page: polls the server's state, shows its image as it refines, and turns mouse
-// drags into camera moves (orbit about the camera's target, pan, zoom) that it posts back.
+// drags into camera moves (orbit about the camera's target, pan, zoom) that it posts back. Until
+// the server's path-traced image of the page's camera is on screen, the scene's meshes are drawn
+// in its place from the page's camera (meshes.js).
 'use strict';
 
 const $ = (id) => document.getElementById(id);
@@ -24,6 +26,16 @@ let shownVersion = -1;  // the image version on screen
 let loading = false;    // an image is being fetched
 let drag = null;        // {x, y, pan} while the mouse is down
 let posting = false, queued = null, awaited = null, awaitedSince = 0;
+let shown = null;       // {camera, preview} of the image on screen
+let meshVersion = 0, meshLoading = false;
+let drawn = '';         // what the meshes' canvas shows: camera, size and meshes
+const meshCanvas = $('meshes');
+let meshPreview = null;
+try {
+  meshPreview = createMeshPreview(meshCanvas);
+} catch (err) {
+  $('mesh-stats').textContent = `no WebGL preview: ${err.message}`;
+}
 
 function sameCamera(a, b) {
   const close = (x, y) => Math.abs(x - y) <= 1e-9 * Math.max(1, Math.abs(x), Math.abs(y));
@@ -35,6 +47,7 @@ function sameCamera(a, b) {
 // A camera move: posted at once, or after the one in flight, the newest replacing any waiting.
 function send(c) {
   camera = c;
+  $('camera-json').value = cameraText(c);
   awaited = c;
   awaitedSince = performance.now();
   if (posting) { queued = c; return; }
@@ -131,13 +144,15 @@ $('copy-camera').addEventListener('click', () => {
   }
 });
 
-function showImage(version) {
+function showImage(version, s) {
   loading = true;
   const next = new Image();
+  const what = {camera: s.camera, preview: s.preview};
   next.onload = () => {
     image.src = next.src;
     image.dataset.version = String(version);
     shownVersion = version;
+    shown = what;
     loading = false;
   };
   next.onerror = () => { loading = false; };
@@ -162,9 +177,45 @@ function show(s) {
     awaited = null;
     camera = s.camera;
   }
-  $('camera-json').value = cameraText(s.camera);
-  if (s.has_image && s.version !== shownVersion && !loading) showImage(s.version);
+  $('camera-json').value = cameraText(camera);
+  if (s.has_image && s.version !== shownVersion && !loading) showImage(s.version, s);
+  if (meshPreview && s.meshes > meshVersion && !meshLoading) loadMeshes();
 }
+
+function loadMeshes() {
+  meshLoading = true;
+  fetch('meshes.bin', {cache: 'no-store'})
+    .then((r) => {
+      if (!r.ok) throw new Error(`meshes: ${r.status}`);
+      const version = Number(r.headers.get('X-Nimbus-Meshes'));
+      return r.arrayBuffer().then((buffer) => {
+        meshPreview.load(buffer, version);
+        meshVersion = version;
+        $('mesh-stats').textContent =
+          `${meshPreview.stats.triangles.toLocaleString('en')} triangles in ${state.mesh_seconds.toFixed(2)} s`;
+      });
+    })
+    .catch((err) => { $('mesh-stats').textContent = err.message; })
+    .finally(() => { meshLoading = false; });
+}
+
+// The meshes stand in for the image until the path tracer's image of this camera is on screen.
+function drawMeshes() {
+  const wanted = meshPreview && meshPreview.ready() && camera && state &&
+    (drag || !shown || shown.preview || !sameCamera(shown.camera, camera));
+  meshCanvas.hidden = !wanted;
+  if (wanted) {
+    const key = JSON.stringify([camera, state.width, state.height, meshVersion]);
+    if (key !== drawn && meshPreview.draw(camera, state.width, state.height)) drawn = key;
+  }
+  requestAnimationFrame(drawMeshes);
+}
+requestAnimationFrame(drawMeshes);
+
+// For tests and benchmarks (bench/viewer_preview.py): the page's camera, the meshes' counters
+// and the preview itself.
+window.nimbusView = {camera: () => camera, meshes: () => meshPreview && meshPreview.stats,
+                     preview: meshPreview};
 
 async function poll() {
   try {
