@@ -118,7 +118,7 @@ int run_export_mesh(const MeshArgs& args) {
     std::fprintf(
         stderr,
         "nimbus: %d object(s), %zu triangles, %zu vertices; largest vertex error %.3g, face "
-        "error %.3g (bound %g) in %.2f s -> %s\n",
+        "error %.3g (bound %g) in %.3f s -> %s\n",
         meshed, mesh.triangles.size(), mesh.positions.size(), vertex_error, face_error, args.error,
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
         args.output.c_str());

@@ -21,6 +21,9 @@ namespace {
 // Grid corners sit off the round coordinates shapes are usually placed at: a shift of this many
 // cells, (3 − √5) / 2.
 constexpr double kGridShift = 0.3819660112501051;
+// A refined grid aims its cell at this fraction of the error bound (the faces' error falling as
+// the square of the cell), leaving room for the prediction's miss.
+constexpr double kAimedError = 0.7;
 // At most this many cells along an axis (a cell's key packs 21 bits per axis).
 constexpr int kMaxAxisCells = (1 << 21) - 2;
 // A cell whose corners share a sign is searched for a hidden piece of the shape down to boxes
@@ -499,8 +502,12 @@ TriangleMesh polygonize(const Tape& tape, const PolygonizeOptions& options,
   const Vec3 extent = bounds.extent();
   const double size = std::max({extent.x, extent.y, extent.z});
   PolygonizeReport r;
-  double h = size / std::max(options.first_cells, 1);
+  const double first_h = size / std::max(options.first_cells, 1);
+  double h = first_h;
   std::uint64_t previous_cells = 0;
+  double growth = 4;     // surface cells of this grid over the last one's, about
+  double predicted = 0;  // this grid's face error as the last one predicted it
+  bool smooth = true;    // the error has fallen as the square of the cell
   for (;;) {
     Grid g;
     g.h = h;
@@ -514,12 +521,12 @@ TriangleMesh polygonize(const Tape& tape, const PolygonizeOptions& options,
             options.error, cells, kMaxAxisCells));
       g.n[size_t(k)] = int(cells);
     }
-    // Surface cells grow about four-fold per halving of the cell.
-    if (options.max_cells > 0 && previous_cells * 4 > options.max_cells)
+    // Surface cells grow as the square of the cell's shrinking.
+    if (options.max_cells > 0 && double(previous_cells) * growth > double(options.max_cells))
       throw PolygonizeError(fmt::format(
-          "an error bound of {:g} needs about {} grid cells at the surface (cell {:.3g}); the "
-          "limit is {}",
-          options.error, previous_cells * 4, h, options.max_cells));
+          "an error bound of {:g} needs about {:.3g} grid cells at the surface (cell {:.3g}); "
+          "the limit is {}",
+          options.error, double(previous_cells) * growth, h, options.max_cells));
     GridMesh gm = mesh_grid(tape, g, options.error);
     ++r.grids;
     r.cell = h;
@@ -531,18 +538,32 @@ TriangleMesh polygonize(const Tape& tape, const PolygonizeOptions& options,
       if (report) *report = r;
       return std::move(gm.mesh);
     }
-    // On a smooth surface the faces' error falls four-fold per halving of the cell: refuse now a
-    // bound whose grid would pass the limit, rather than after meshing the grids on the way.
+    // On a smooth surface the faces' error falls as the square of the cell: the next cell is the
+    // one that predicts kAimedError of the bound, between a quarter and 0.8 of this one, so that
+    // the mesh lands near the bound rather than up to four times below it (a halving's). A grid
+    // that hides a piece of the shape, or holds none of it, is halved. Refuse now a bound whose
+    // grid would pass the limit, rather than after meshing the grids on the way.
+    // Where the error fell less than predicted (a curved sharp edge, whose chamfer shrinks only as
+    // the cell, and unevenly with the grid's alignment), the cells are the first grid's halved
+    // from then on, the next such below this one.
+    if (predicted > 0 && r.face_error > 1.5 * predicted) smooth = false;
+    double factor = 0.5;
+    if (smooth && !gm.hidden && !gm.mesh.triangles.empty() && r.face_error > options.error)
+      factor = std::clamp(std::sqrt(kAimedError * options.error / r.face_error), 0.25, 0.8);
+    predicted = r.face_error * factor * factor;
     if (options.max_cells > 0 && r.face_error > options.error) {
-      const double halvings = std::ceil(std::log(r.face_error / options.error) / std::log(4.0));
-      const double estimate = double(previous_cells) * std::pow(4.0, halvings);
+      const double estimate = double(previous_cells) * r.face_error / options.error;
       if (estimate > double(options.max_cells))
         throw PolygonizeError(fmt::format(
             "an error bound of {:g} needs about {:.3g} grid cells at the surface (cell {:.3g}); "
             "the limit is {}",
-            options.error, estimate, h * std::pow(0.5, halvings), options.max_cells));
+            options.error, estimate, h * std::sqrt(options.error / r.face_error),
+            options.max_cells));
     }
-    h *= 0.5;
+    const double next =
+        smooth ? h * factor : first_h * std::exp2(-std::floor(std::log2(first_h / h) + 1e-9) - 1);
+    growth = (h / next) * (h / next);
+    h = next;
   }
 }
 
