@@ -1,0 +1,141 @@
+#!/usr/bin/env python3
+"""nimbus export-mesh against libfive's dual contouring on the same shapes at the same error
+(issue 43; docs/benchmarks.md, "Meshes side by side").
+
+For each shape and error bound E, nimbus meshes with `--error E`; libfive (built from source
+outside this repository) meshes at the coarsest min_feature, halving from a quarter of the
+shape's box, whose mesh measures within E (largest vertex and face-centroid distance to the
+exact surface). Both meshes are measured by the same tool, mesh_error (bench/mesh_error.cpp:
+nimbus's exact roots, so the same yardstick for both), and timed on 1 and 2 threads (the
+commands' own seconds, meshing and writing the file; the median of --reps runs), with the
+process's peak memory (GNU time).
+
+  LIBFIVE_SRC=/path/to/libfive LIBFIVE_BUILD=/path/to/libfive/build \\
+    /usr/bin/python3 bench/mesh_side_by_side.py [--nimbus build/nimbus] \\
+    [--mesh-error build/mesh_error] [--reps 3] [--errors 0.004,0.001] [SHAPE...]
+
+LIBFIVE_SRC is a checkout of github.com/libfive/libfive, LIBFIVE_BUILD its CMake build with the
+`five` library built (`cmake -DCMAKE_BUILD_TYPE=Release -DBUILD_STUDIO_APP=OFF
+-DBUILD_GUILE_BINDINGS=OFF -DBUILD_PYTHON_BINDINGS=OFF -DENABLE_DEBUG=OFF`; Debian's
+libeigen3-dev, libboost-dev and libpng-dev). Unset: prints why and exits 0. Shapes: sphere,
+freeform4, cylinder (default: all).
+"""
+import argparse
+import json
+import os
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+# nimbus's side of bench/libfive/mesh_libfive.cpp's shapes, and each shape's box half-width there.
+SHAPES = {
+    "sphere": ({"type": "sphere", "radius": 1}, 1.1),
+    "freeform4": ({"type": "freeform", "base": {"type": "ellipsoid", "radii": [0.95, 0.8, 0.8]},
+                   "perturbations": [
+                       {"shape": {"type": "sphere", "center": [0.55, 0.45, 0.3], "radius": 0.45}, "weight": 0.8},
+                       {"shape": {"type": "sphere", "center": [-0.6, 0.35, -0.2], "radius": 0.4}, "weight": 0.8},
+                       {"shape": {"type": "sphere", "center": [0.1, -0.7, 0.5], "radius": 0.5}, "weight": -0.6},
+                       {"shape": {"type": "sphere", "center": [0.0, 0.3, 0.75], "radius": 0.35}, "weight": 0.5}]},
+                  1.3),
+    "cylinder": ({"type": "intersection", "shapes": [
+        {"type": "cylinder", "axis": [0, 0, 1], "radius": 0.5},
+        {"type": "slab", "normal": [0, 0, 1], "thickness": 1.6}]}, 1.0),
+}
+
+
+def timed(cmd):
+    """Runs cmd under GNU time; returns (stdout, stderr without time's line, peak MiB)."""
+    r = subprocess.run(["/usr/bin/time", "-f", "peak %M", *cmd], capture_output=True, text=True)
+    if r.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)}: exit {r.returncode}: {r.stderr.strip()}")
+    peak = int(re.search(r"peak (\d+)", r.stderr).group(1)) / 1024
+    return r.stdout, r.stderr, peak
+
+
+def measure(args, scene, mesh):
+    out = subprocess.run([args.mesh_error, scene, mesh, "--samples", "2000"], check=True,
+                         capture_output=True, text=True).stdout
+    return json.loads(out)
+
+
+def run_nimbus(args, scene, error, threads, mesh):
+    _, err, peak = timed([args.nimbus, "export-mesh", scene, "-o", mesh, "--error", str(error),
+                          "--threads", str(threads)])
+    return float(re.search(r" in ([0-9.]+) s ->", err).group(1)), peak
+
+
+def run_libfive(args, exe, shape, feature, threads, mesh):
+    out, _, peak = timed([exe, shape, repr(feature), str(threads), mesh])
+    return json.loads(out)["seconds"], peak
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--nimbus", default="build/nimbus")
+    ap.add_argument("--mesh-error", default="build/mesh_error")
+    ap.add_argument("--reps", type=int, default=3)
+    ap.add_argument("--errors", default="0.004,0.001")
+    ap.add_argument("--out", default=None, help="work folder (default: a temporary one)")
+    ap.add_argument("shapes", nargs="*", default=list(SHAPES))
+    args = ap.parse_args()
+    src, build = os.environ.get("LIBFIVE_SRC"), os.environ.get("LIBFIVE_BUILD")
+    if not src or not build:
+        print("mesh_side_by_side: skipped: set LIBFIVE_SRC and LIBFIVE_BUILD (a libfive checkout "
+              "and its build)", file=sys.stderr)
+        return 0
+    work = args.out or tempfile.mkdtemp(prefix="nimbus-meshes-")
+    os.makedirs(work, exist_ok=True)
+    lib = os.path.join(build, "libfive", "src")
+    exe = os.path.join(work, "mesh_libfive")
+    # libfive's own flags: -march=native changes Eigen's alignment, and so the objects' layout.
+    subprocess.run(["g++", "-O3", "-march=native", "-DEIGEN_NO_DEBUG", "-std=c++17",
+                    os.path.join(HERE, "libfive", "mesh_libfive.cpp"),
+                    "-I", os.path.join(src, "libfive", "include"), "-I", "/usr/include/eigen3",
+                    "-L", lib, "-lfive", f"-Wl,-rpath,{lib}", "-o", exe], check=True)
+    print("| shape | E | mesher | setting | triangles | vertex error | face error | Hausdorff "
+          "(samples) | 1 thread (s) | 2 threads (s) | peak memory |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for shape in args.shapes:
+        desc, half = SHAPES[shape]
+        scene = os.path.join(work, f"{shape}.json")
+        with open(scene, "w") as f:
+            json.dump({"camera": {"from": [0, 0, 5], "to": [0, 0, 0]},
+                       "objects": [{"shape": desc, "surface": {"type": "diffuse"}}]}, f)
+        for error in (float(e) for e in args.errors.split(",")):
+            mesh = os.path.join(work, f"{shape}-nimbus.stl")
+            # libfive's coarsest setting within E.
+            feature = 2 * half / 4
+            while True:
+                lmesh = os.path.join(work, f"{shape}-libfive.stl")
+                run_libfive(args, exe, shape, feature, 2, lmesh)
+                m = measure(args, scene, lmesh)
+                if max(m["vertex_error"], m["face_error"]) <= error or feature < error / 64:
+                    break
+                feature /= 2
+            # Timed interleaved: nimbus and libfive take turns within each repetition.
+            times, ltimes = {1: [], 2: []}, {1: [], 2: []}
+            peak = lpeak = 0
+            for _ in range(args.reps):
+                for threads in (1, 2):
+                    t, p = run_nimbus(args, scene, error, threads, mesh)
+                    times[threads].append(t)
+                    peak = max(peak, p)
+                    t, p = run_libfive(args, exe, shape, feature, threads, lmesh)
+                    ltimes[threads].append(t)
+                    lpeak = max(lpeak, p)
+            n = measure(args, scene, mesh)
+            for name, setting, r, ts, pk in (("nimbus", f"--error {error:g}", n, times, peak),
+                                             ("libfive", f"min_feature {feature:.3g}", m, ltimes, lpeak)):
+                print(f"| {shape} | {error:g} | {name} | {setting} | {r['triangles']:,} "
+                      f"| {r['vertex_error']:.2g} | {r['face_error']:.2g} | {r['hausdorff']:.2g} "
+                      f"| {statistics.median(ts[1]):.3f} | {statistics.median(ts[2]):.3f} "
+                      f"| {pk:.0f} MiB |", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
