@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -16,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -192,6 +194,49 @@ TEST(Polygonize, FreeFormWithFourPerturbations) {
 
 // A spike: a thin upright ellipsoid perturbing a ball. Its tip, the exact surface's highest point
 // on the axis, must be in the mesh within 2ε.
+// The dihedral angles of the mesh edges that lie on a sharp edge of the shape (both ends and the
+// midpoint): `on_edge` says whether a point is on it.
+template <class OnEdge>
+std::vector<double> sharp_edge_angles(const TriangleMesh& m, OnEdge&& on_edge) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<Vec3>> faces;
+  for (const auto& t : m.triangles) {
+    const Vec3 n = normalize(
+        cross(m.positions[t[1]] - m.positions[t[0]], m.positions[t[2]] - m.positions[t[0]]));
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = t[size_t(k)], b = t[size_t((k + 1) % 3)];
+      faces[{std::min(a, b), std::max(a, b)}].push_back(n);
+    }
+  }
+  std::vector<double> angles;
+  for (const auto& [edge, normals] : faces)
+    if (normals.size() == 2 && on_edge(m.positions[edge.first]) &&
+        on_edge(m.positions[edge.second]) &&
+        on_edge((m.positions[edge.first] + m.positions[edge.second]) * 0.5))
+      angles.push_back(std::acos(std::clamp(dot(normals[0], normals[1]), -1.0, 1.0)) * 180 / kPi);
+  return angles;
+}
+
+// A CSG edge is kept: the mesh edges along a cylinder's rim, cut by a slab, meet at 90° within
+// 5° (a curved sharp edge: issue 43). A box turned off the grid's axes is not yet (docs/meshes.md,
+// "Limits": chamfers where a cell sees one face of the edge).
+TEST(Polygonize, CylinderCutBySlabKeepsItsRim) {
+  const double eps = 0.003;
+  const Tape cylinder = tape_of(R"({"type": "intersection", "shapes": [
+      {"type": "cylinder", "axis": [0, 0, 1], "radius": 0.5},
+      {"type": "slab", "normal": [0, 0, 1], "thickness": 1.6}]})");
+  const Checked c = mesh_and_check(cylinder, eps);
+  EXPECT_EQ(c.topology.euler, 2);
+  // Within the area times ε of π r² h.
+  EXPECT_NEAR(enclosed_volume(c.mesh), kPi * 0.25 * 1.6,
+              (2 * kPi * 0.25 + 2 * kPi * 0.5 * 1.6) * eps);
+  const auto on_rim = [&](const Vec3& p) {
+    return std::abs(std::hypot(p.x, p.y) - 0.5) <= eps && std::abs(std::abs(p.z) - 0.8) <= eps;
+  };
+  const std::vector<double> rim_angles = sharp_edge_angles(c.mesh, on_rim);
+  EXPECT_GE(rim_angles.size(), 16u);
+  for (double a : rim_angles) EXPECT_NEAR(a, 90, 5);
+}
+
 TEST(Polygonize, ThinFreeFormSpikeKeepsItsTip) {
   const Tape tape = tape_of(R"({"type": "freeform",
       "base": {"type": "sphere", "center": [0, 0, 0], "radius": 0.5},

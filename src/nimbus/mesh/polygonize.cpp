@@ -453,9 +453,23 @@ GridMesh mesh_grid(const Tape& tape, const Grid& g, double error) {
   return out;
 }
 
-// The largest distance from a face's sample points (centroid, edge midpoints) to the surface
-// (surface_distance along the face's normal).
-double face_error(const Tape& tape, const TriangleMesh& mesh, double reach) {
+// A point's distance to the surface, tighter than surface_distance where that is above `bound`:
+// the least root along 13 more fixed directions (axes, face and cube diagonals). Along a face's
+// normal, a point on a sharp edge's chamfer may see the far side of the shape first, which
+// would refine the whole grid for an error that is not there.
+double tight_distance(const Tape& tape, const Vec3& p, const Vec3& n, double reach, double bound) {
+  double d = surface_distance(tape, p, n, reach);
+  for (int x = -1; x <= 1 && d > bound; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z)
+        if (x > 0 || (x == 0 && y > 0) || (x == 0 && y == 0 && z > 0))
+          d = std::min(
+              d, distance_along(tape, p, normalize(Vec3{double(x), double(y), double(z)}), reach));
+  return d;
+}
+
+// The largest distance of a face's centroid or edge midpoint to the surface.
+double face_error(const Tape& tape, const TriangleMesh& mesh, double reach, double bound) {
   std::vector<double> worst(mesh.triangles.size(), 0);
   tbb::parallel_for(std::size_t{0}, mesh.triangles.size(), [&](std::size_t i) {
     const auto& t = mesh.triangles[i];
@@ -464,7 +478,7 @@ double face_error(const Tape& tape, const TriangleMesh& mesh, double reach) {
     if (!(length(n) > 0)) return;
     const Vec3 u = normalize(n);
     for (const Vec3& p : {(a + b + c) / 3.0, (a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5})
-      worst[i] = std::max(worst[i], surface_distance(tape, p, u, reach));
+      worst[i] = std::max(worst[i], tight_distance(tape, p, u, reach, bound));
   });
   return worst.empty() ? 0.0 : *std::max_element(worst.begin(), worst.end());
 }
@@ -532,7 +546,7 @@ TriangleMesh polygonize(const Tape& tape, const PolygonizeOptions& options,
     r.cell = h;
     r.cells = gm.cells;
     r.vertex_error = gm.vertex_error;
-    r.face_error = face_error(tape, gm.mesh, 2 * h);
+    r.face_error = face_error(tape, gm.mesh, 2 * h, options.error);
     previous_cells = std::max<std::uint64_t>(gm.cells, 1);
     if (!gm.hidden && r.face_error <= options.error && !gm.mesh.triangles.empty()) {
       if (report) *report = r;
