@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <deque>
 #include <limits>
 #include <numeric>
 #include <optional>
+#include <unordered_map>
 #include <vector>
 
 #include "nimbus/frep/intersect.h"
@@ -21,6 +23,9 @@ namespace {
 // Grid corners sit off the round coordinates shapes are usually placed at: a shift of this many
 // cells, (3 − √5) / 2.
 constexpr double kGridShift = 0.3819660112501051;
+// A grid whose failing faces are at most one in this many has them bisected (bisect_failing_faces)
+// rather than the whole grid refined.
+constexpr std::size_t kFewFailing = 20;
 // A refined grid aims its cell at this fraction of the error bound (the faces' error falling as
 // the square of the cell), leaving room for the prediction's miss.
 constexpr double kAimedError = 0.7;
@@ -468,19 +473,128 @@ double tight_distance(const Tape& tape, const Vec3& p, const Vec3& n, double rea
   return d;
 }
 
-// The largest distance of a face's centroid or edge midpoint to the surface.
-double face_error(const Tape& tape, const TriangleMesh& mesh, double reach, double bound) {
-  std::vector<double> worst(mesh.triangles.size(), 0);
+// The largest distance of a face's centroid or edge midpoints to the surface.
+double face_distance(const Tape& tape, const TriangleMesh& mesh,
+                     const std::array<std::uint32_t, 3>& t, double reach, double bound) {
+  const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]];
+  const Vec3 n = cross(b - a, c - a);
+  if (!(length(n) > 0)) return 0;
+  const Vec3 u = normalize(n);
+  double worst = 0;
+  for (const Vec3& p : {(a + b + c) / 3.0, (a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5})
+    worst = std::max(worst, tight_distance(tape, p, u, reach, bound));
+  return worst;
+}
+
+// Each face's face_distance.
+std::vector<double> face_distances(const Tape& tape, const TriangleMesh& mesh, double reach,
+                                   double bound) {
+  std::vector<double> d(mesh.triangles.size(), 0);
   tbb::parallel_for(std::size_t{0}, mesh.triangles.size(), [&](std::size_t i) {
-    const auto& t = mesh.triangles[i];
-    const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]];
-    const Vec3 n = cross(b - a, c - a);
-    if (!(length(n) > 0)) return;
-    const Vec3 u = normalize(n);
-    for (const Vec3& p : {(a + b + c) / 3.0, (a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5})
-      worst[i] = std::max(worst[i], tight_distance(tape, p, u, reach, bound));
+    d[i] = face_distance(tape, mesh, mesh.triangles[i], reach, bound);
   });
-  return worst.empty() ? 0.0 : *std::max_element(worst.begin(), worst.end());
+  return d;
+}
+
+// The point of the surface nearest p among the roots along n, the gradient and 13 fixed
+// directions (axes, face and cube diagonals), within reach; none if there is none.
+std::optional<Vec3> nearest_surface_point(const Tape& tape, const Vec3& p, const Vec3& n,
+                                          double reach) {
+  std::vector<Vec3> directions{n, outward(tape, p)};
+  for (int x = -1; x <= 1; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z)
+        if (x > 0 || (x == 0 && y > 0) || (x == 0 && y == 0 && z > 0))
+          directions.push_back(normalize(Vec3{double(x), double(y), double(z)}));
+  std::optional<Vec3> best;
+  double best_t = reach;
+  for (const Vec3& d : directions) {
+    if (!(length(d) > 0)) continue;
+    const Vec3 u = normalize(d);
+    if (const auto t = nearest_root(tape, p, u, best_t); t && std::abs(*t) < best_t) {
+      best_t = std::abs(*t);
+      best = p + u * *t;
+    }
+  }
+  return best;
+}
+
+// Makes good the faces further than `error` from the surface by bisecting them, rather than by
+// refining the whole grid: where few faces fail (chamfers along a sharp edge off the grid's axes,
+// whose depth falls only as the cell), a failing face's longest edge is split at its midpoint
+// moved onto the surface, in both faces that share it, so that the mesh stays closed and
+// 2-manifold, until every face is within the bound. Sequential, in the faces' order: the same
+// mesh for any number of threads. False, with the mesh half done, where a midpoint finds no
+// surface within reach or the faces pass max_faces.
+bool bisect_failing_faces(const Tape& tape, TriangleMesh& m, const std::vector<double>& distance,
+                          double error, double reach, std::size_t max_faces) {
+  using Face = std::array<std::uint32_t, 3>;
+  constexpr std::uint32_t kNone = ~std::uint32_t{0};
+  const auto key = [](std::uint32_t a, std::uint32_t b) {
+    return (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
+  };
+  // Each edge's two faces.
+  std::unordered_map<std::uint64_t, std::array<std::uint32_t, 2>> faces_of;
+  faces_of.reserve(m.triangles.size() * 3 / 2);
+  const auto attach = [&](std::uint32_t a, std::uint32_t b, std::uint32_t face) {
+    auto [it, fresh] = faces_of.try_emplace(key(a, b), std::array<std::uint32_t, 2>{face, kNone});
+    if (!fresh) it->second[1] = face;
+  };
+  const auto replace = [&](std::uint32_t a, std::uint32_t b, std::uint32_t from, std::uint32_t to) {
+    auto& f = faces_of.at(key(a, b));
+    (f[0] == from ? f[0] : f[1]) = to;
+  };
+  for (std::uint32_t i = 0; i < m.triangles.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      attach(m.triangles[i][size_t(k)], m.triangles[i][size_t(k + 1) % 3], i);
+  std::deque<std::uint32_t> failing;
+  for (std::uint32_t i = 0; i < m.triangles.size(); ++i)
+    if (distance[i] > error) failing.push_back(i);
+  while (!failing.empty()) {
+    const std::uint32_t t = failing.front();
+    failing.pop_front();
+    if (face_distance(tape, m, m.triangles[t], reach, error) <= error) continue;
+    if (m.triangles.size() + 2 > max_faces) return false;
+    // The longest edge, as (a, b) in the face's order, and c the third vertex.
+    Face f = m.triangles[t];
+    int k = 0;
+    for (int j = 1; j < 3; ++j)
+      if (length(m.positions[f[size_t(j)]] - m.positions[f[size_t(j + 1) % 3]]) >
+          length(m.positions[f[size_t(k)]] - m.positions[f[size_t(k + 1) % 3]]))
+        k = j;
+    const std::uint32_t a = f[size_t(k)], b = f[size_t(k + 1) % 3], c = f[size_t(k + 2) % 3];
+    const auto& pair = faces_of.at(key(a, b));
+    const std::uint32_t u = pair[0] == t ? pair[1] : pair[0];
+    if (u == kNone) return false;
+    const Face g = m.triangles[u];
+    int j = 0;
+    while (g[size_t(j)] == a || g[size_t(j)] == b) ++j;
+    const std::uint32_t d = g[size_t(j)];
+    const Vec3 n = m.normals[a] + m.normals[b];
+    const auto p = nearest_surface_point(tape, (m.positions[a] + m.positions[b]) * 0.5,
+                                         length(n) > 0 ? normalize(n) : Vec3{0, 0, 1}, reach);
+    if (!p || length(m.positions[a] - m.positions[b]) < 1e-9 * reach) return false;
+    const auto v = std::uint32_t(m.positions.size());
+    m.positions.push_back(*p);
+    const Vec3 nv = outward(tape, *p);
+    m.normals.push_back(length(nv) > 0 ? nv : normalize(n));
+    // t = (a, b, c) becomes (a, v, c) and t1 = (v, b, c); u = (b, a, d) becomes (b, v, d) and
+    // u1 = (v, a, d): the orientation kept.
+    const auto t1 = std::uint32_t(m.triangles.size()), u1 = t1 + 1;
+    m.triangles[t] = {a, v, c};
+    m.triangles.push_back({v, b, c});
+    m.triangles[u] = {b, v, d};
+    m.triangles.push_back({v, a, d});
+    faces_of.erase(key(a, b));
+    replace(b, c, t, t1);
+    replace(a, d, u, u1);
+    faces_of[key(a, v)] = {t, u1};
+    faces_of[key(v, b)] = {t1, u};
+    faces_of[key(v, c)] = {t, t1};
+    faces_of[key(v, d)] = {u, u1};
+    for (std::uint32_t face : {t, t1, u, u1}) failing.push_back(face);
+  }
+  return true;
 }
 
 }  // namespace
@@ -546,11 +660,33 @@ TriangleMesh polygonize(const Tape& tape, const PolygonizeOptions& options,
     r.cell = h;
     r.cells = gm.cells;
     r.vertex_error = gm.vertex_error;
-    r.face_error = face_error(tape, gm.mesh, 2 * h, options.error);
+    const std::vector<double> distance = face_distances(tape, gm.mesh, 2 * h, options.error);
+    r.face_error = distance.empty() ? 0 : *std::max_element(distance.begin(), distance.end());
     previous_cells = std::max<std::uint64_t>(gm.cells, 1);
-    if (!gm.hidden && r.face_error <= options.error && !gm.mesh.triangles.empty()) {
-      if (report) *report = r;
-      return std::move(gm.mesh);
+    if (!gm.hidden && !gm.mesh.triangles.empty()) {
+      if (r.face_error <= options.error) {
+        if (report) *report = r;
+        return std::move(gm.mesh);
+      }
+      // Few failing faces: bisected where they fail (up to four times the faces, within the
+      // memory budget), else the grid is refined.
+      const auto failing = std::size_t(std::count_if(distance.begin(), distance.end(),
+                                                     [&](double d) { return d > options.error; }));
+      if (failing * kFewFailing <= distance.size()) {
+        TriangleMesh bisected = gm.mesh;
+        // Two faces a surface cell: the memory budget's count (kPolygonizeBytesPerCell).
+        const std::size_t budget =
+            options.max_cells > 0 ? std::size_t(2 * options.max_cells) : ~std::size_t{0};
+        if (bisect_failing_faces(tape, bisected, distance, options.error, 2 * h,
+                                 std::min(4 * gm.mesh.triangles.size(), budget))) {
+          r.face_error = 0;
+          for (const auto& t : bisected.triangles)
+            r.face_error = std::max(r.face_error, face_distance(tape, bisected, t, 2 * h, 0));
+          r.bisected = bisected.triangles.size() - gm.mesh.triangles.size();
+          if (report) *report = r;
+          return bisected;
+        }
+      }
     }
     // On a smooth surface the faces' error falls as the square of the cell: the next cell is the
     // one that predicts kAimedError of the bound, between a quarter and 0.8 of this one, so that

@@ -30,11 +30,12 @@ struct PolygonizeOptions {
 };
 
 struct PolygonizeReport {
-  double cell = 0;          // the last grid's cell size
-  int grids = 0;            // grids meshed, coarse to fine
-  std::uint64_t cells = 0;  // the last grid's cells that may hold the surface
-  double vertex_error = 0;  // the largest vertex distance to the surface (exact root)
-  double face_error = 0;    // the largest distance of a face's sample point to the surface
+  double cell = 0;             // the last grid's cell size
+  int grids = 0;               // grids meshed, coarse to fine
+  std::uint64_t cells = 0;     // the last grid's cells that may hold the surface
+  double vertex_error = 0;     // the largest vertex distance to the surface (exact root)
+  double face_error = 0;       // the largest distance of a face's sample point to the surface
+  std::uint64_t bisected = 0;  // faces added by bisecting failing faces of the last grid
 };
 
 // A request polygonize refuses: ε not positive, an empty or unbounded shape, or a grid past
