@@ -28,11 +28,9 @@
 #include <string>
 #include <vector>
 
-#include "nimbus/frep/intersect.h"
 #include "nimbus/math/constants.h"
-#include "nimbus/math/rng.h"
+#include "nimbus/mesh/measure.h"
 #include "nimbus/mesh/polygonize.h"
-#include "nimbus/render/sampling.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
 
@@ -61,28 +59,6 @@ std::vector<Triangle> read_stl(const std::string& path) {
   return out;
 }
 
-double point_triangle_distance(const Vec3& p, const Triangle& t) {
-  // The closest point by the region of the triangle's plane it falls in (Voronoi regions).
-  const Vec3 ab = t.b - t.a, ac = t.c - t.a, ap = p - t.a;
-  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
-  if (d1 <= 0 && d2 <= 0) return length(ap);
-  const Vec3 bp = p - t.b;
-  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return length(bp);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return length(p - (t.a + ab * (d1 / (d1 - d3))));
-  const Vec3 cp = p - t.c;
-  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return length(cp);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return length(p - (t.a + ac * (d2 / (d2 - d6))));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0)
-    return length(p - (t.b + (t.c - t.b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
-  const double s = 1 / (va + vb + vc);
-  return length(p - (t.a + ab * (vb * s) + ac * (vc * s)));
-}
-
 // Triangles bucketed in a uniform grid by their boxes, for the distance from a point near the
 // mesh: the cells within a radius, the radius doubled until a triangle lies within it.
 class TriangleGrid {
@@ -102,7 +78,7 @@ class TriangleGrid {
         const auto found = cells_.find(k);
         if (found == cells_.end()) return;
         for (std::uint32_t i : found->second)
-          best = std::min(best, point_triangle_distance(p, tris_[i]));
+          best = std::min(best, point_triangle_distance(p, tris_[i].a, tris_[i].b, tris_[i].c));
       });
       if (best <= radius) return best;
     }
@@ -125,24 +101,6 @@ class TriangleGrid {
   double cell_;
   std::map<Key, std::vector<std::uint32_t>> cells_;
 };
-
-// Surface points: the exact first roots of rays from outside the bounds towards random points
-// near the centre.
-std::vector<Vec3> surface_samples(const Tape& tape, int count) {
-  const Box b = tape.bounds.box;
-  const Vec3 c = b.center();
-  const double r = length(b.extent());
-  Rng rng(17, 0);
-  std::vector<Vec3> out;
-  while (int(out.size()) < count) {
-    const Vec3 from = c + sample_uniform_sphere(rng.uniform(), rng.uniform()) * r;
-    const Vec3 to = c + Vec3{rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5} *
-                            (0.5 * length(b.extent()) / std::sqrt(3.0));
-    const Vec3 d = normalize(to - from);
-    if (const auto t = first_hit(tape, Ray{from, d}, 0, 2 * r)) out.push_back(from + d * *t);
-  }
-  return out;
-}
 
 int run(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);

@@ -25,9 +25,8 @@
 #include "nimbus/frep/intersect.h"
 #include "nimbus/io/mesh_file.h"
 #include "nimbus/math/constants.h"
-#include "nimbus/math/rng.h"
+#include "nimbus/mesh/measure.h"
 #include "nimbus/mesh/polygonize.h"
-#include "nimbus/render/sampling.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
 #include "support/process.h"
@@ -43,52 +42,12 @@ Tape tape_of(const std::string& shape) {
   return compile_scene(load_scene_text(text, "mesh_test")).objects.at(0).tape;
 }
 
-double point_triangle_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  // Closest point on the triangle by its region (Ericson, Real-Time Collision Detection 5.1.5).
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
-  if (d1 <= 0 && d2 <= 0) return length(p - a);
-  const Vec3 bp = p - b;
-  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return length(p - b);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return length(p - (a + ab * (d1 / (d1 - d3))));
-  const Vec3 cp = p - c;
-  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return length(p - c);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return length(p - (a + ac * (d2 / (d2 - d6))));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0)
-    return length(p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
-  const double denom = 1 / (va + vb + vc);
-  return length(p - (a + ab * (vb * denom) + ac * (vc * denom)));
-}
-
 double distance_to_mesh(const TriangleMesh& m, const Vec3& p) {
   double best = kInf;
   for (const auto& t : m.triangles)
     best = std::min(
         best, point_triangle_distance(p, m.positions[t[0]], m.positions[t[1]], m.positions[t[2]]));
   return best;
-}
-
-// Surface points: the exact first roots of rays from outside the bounds towards random points
-// near the centre.
-std::vector<Vec3> surface_samples(const Tape& tape, int count) {
-  const Box b = tape.bounds.box;
-  const Vec3 c = b.center();
-  const double r = length(b.extent());
-  Rng rng(17, 0);
-  std::vector<Vec3> out;
-  while (int(out.size()) < count) {
-    const Vec3 from = c + sample_uniform_sphere(rng.uniform(), rng.uniform()) * r;
-    const Vec3 to = c + Vec3{rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5} *
-                            (0.5 * length(b.extent()) / std::sqrt(3.0));
-    const Vec3 d = normalize(to - from);
-    if (const auto t = first_hit(tape, Ray{from, d}, 0, 2 * r)) out.push_back(from + d * *t);
-  }
-  return out;
 }
 
 struct Checked {
