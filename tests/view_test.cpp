@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <sys/stat.h>
+#include <tbb/task_arena.h>
 
 #include <cmath>
 #include <cstring>
@@ -382,6 +383,22 @@ TEST(PreviewMeshes, AnEditReMeshesOnlyTheObjectsItChanged) {
   const double r = 1.2;
   EXPECT_NEAR(enclosed_volume(grown.objects[0].mesh), 4 * std::numbers::pi * r * r * r / 3,
               4 * std::numbers::pi * r * r * (2 * r / 256));
+}
+
+TEST(PreviewMeshes, StopAtTheBudgetOfTriangles) {
+  const Scene scene = compile_scene(load_scene_text(meshes_scene(1, "0.5"), "m"));
+  PreviewMeshOptions o;
+  o.max_triangles = 100;
+  PreviewMesher mesher(o);
+  PreviewMeshStats stats;
+  // On one thread the objects are meshed in order: the first passes the budget.
+  tbb::task_arena one(1);
+  const DecodedMeshes d =
+      one.execute([&] { return decode_meshes(mesher.update(preview_scene(scene), &stats)); });
+  EXPECT_EQ(stats.meshed, 1);
+  EXPECT_EQ(stats.skipped, 2);
+  ASSERT_EQ(d.objects.size(), 1u);
+  EXPECT_GT(d.objects[0].mesh.triangles.size(), 100u);
 }
 
 TEST_F(Session, MeshesEachSceneItLoads) {

@@ -3,9 +3,12 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <string_view>
+#include <unordered_map>
 
 #include "nimbus/mesh/polygonize.h"
 
@@ -179,13 +182,20 @@ std::string PreviewMesher::update(const PreviewScene& scene, PreviewMeshStats* s
     const auto found = meshes_.find(keys[i]);
     if (found != meshes_.end()) meshes[i] = found->second;
   }
+  // Copies of one object (the same function, placed the same) share a key and are meshed once,
+  // by the first.
+  std::unordered_map<std::string_view, size_t> first_of;
+  for (size_t i = 0; i < n; ++i)
+    if (!scene.objects[i].mesh) first_of.try_emplace(keys[i], i);
   // The objects met for the first time, meshed side by side (each mesh is the same for any
-  // number of threads).
+  // number of threads), until the meshes pass the page's budget of triangles: a scene of many
+  // thousand objects shows the first of them.
+  std::atomic<std::uint64_t> triangles{0};
+  for (const auto& m : meshes)
+    if (m) triangles += m->triangles.size();
   tbb::parallel_for(size_t(0), n, [&](size_t i) {
-    if (meshes[i] || scene.objects[i].mesh) return;
-    // Copies of one object (instances) share a key and are meshed once, by the first.
-    for (size_t j = 0; j < i; ++j)
-      if (keys[j] == keys[i]) return;
+    if (meshes[i] || scene.objects[i].mesh || first_of.at(keys[i]) != i) return;
+    if (triangles.load(std::memory_order_relaxed) > options_.max_triangles) return;
     const Tape& tape = scene.objects[i].tape;
     if (!tape.bounds.bounded || tape.bounds.box.empty()) return;
     PolygonizeOptions po;
@@ -197,6 +207,7 @@ std::string PreviewMesher::update(const PreviewScene& scene, PreviewMeshStats* s
       try {
         meshes[i] = std::make_shared<const TriangleMesh>(polygonize(tape, po));
         fresh[i] = 1;
+        triangles += meshes[i]->triangles.size();
         return;
       } catch (const PolygonizeError&) {
       }
@@ -210,10 +221,7 @@ std::string PreviewMesher::update(const PreviewScene& scene, PreviewMeshStats* s
       st.triangles += meshes[i]->triangles.size();
       continue;
     }
-    if (!meshes[i]) {
-      const auto first = std::find(keys.begin(), keys.end(), keys[i]) - keys.begin();
-      meshes[i] = meshes[size_t(first)];
-    }
+    if (!meshes[i]) meshes[i] = meshes[first_of.at(keys[i])];
     if (!meshes[i]) {
       ++st.skipped;
       continue;

@@ -51,10 +51,14 @@ struct PreviewMeshOptions {
   double scene_error = 1.0 / 2048;    // and at least this fraction of the scene's (rounded)
   // Surface cells one object may take (memory and time); past it the object is meshed coarser.
   std::uint64_t max_cells = 1 << 18;
+  // Triangles the page is sent at most, about: objects past it (in a scene of many thousand)
+  // are not meshed, and are counted as skipped.
+  std::uint64_t max_triangles = 4 << 20;
 };
 
 struct PreviewMeshStats {
-  int meshed = 0, reused = 0, skipped = 0;  // skipped: empty, unbounded or too fine to mesh
+  int meshed = 0, reused = 0, skipped = 0;  // skipped: empty, unbounded, too fine or past the
+                                            // budget of triangles
   int given = 0;                            // sphere lights
   std::uint64_t triangles = 0;
 };

@@ -125,11 +125,16 @@ bool ViewSession::load() {
     file_camera_ = desc.camera;
     scene->camera = compile_camera(camera_, scene->settings);
     scene_ = std::move(scene);
+    std::optional<PreviewScene> meshes;
+    if (options_.mesh_error > 0) meshes = preview_scene(*scene_);
+    // The frame's film is the new scene's before the load counts: a caller that waits for the
+    // load (or is woken by the mesher) never sees the old film under the new count.
+    restart(Clock::now());
     std::lock_guard lock(mutex_);
     frame_.error.clear();
     ++frame_.loads;
-    if (options_.mesh_error > 0) {
-      pending_meshes_ = preview_scene(*scene_);
+    if (meshes) {
+      pending_meshes_ = std::move(meshes);
       mesh_wake_.notify_all();
     }
   } catch (const std::exception& e) {
@@ -140,7 +145,6 @@ bool ViewSession::load() {
     changed_.notify_all();
     return false;
   }
-  restart(Clock::now());
   return true;
 }
 
