@@ -464,12 +464,15 @@ GridMesh mesh_grid(const Tape& tape, const Grid& g, double error) {
 // would refine the whole grid for an error that is not there.
 double tight_distance(const Tape& tape, const Vec3& p, const Vec3& n, double reach, double bound) {
   double d = surface_distance(tape, p, n, reach);
+  // Only whether a root lies within the bound matters: each direction is searched that far (a
+  // short search, where interval root finding costs most), and the first one found ends it.
   for (int x = -1; x <= 1 && d > bound; ++x)
-    for (int y = -1; y <= 1; ++y)
-      for (int z = -1; z <= 1; ++z)
+    for (int y = -1; y <= 1 && d > bound; ++y)
+      for (int z = -1; z <= 1 && d > bound; ++z)
         if (x > 0 || (x == 0 && y > 0) || (x == 0 && y == 0 && z > 0))
-          d = std::min(
-              d, distance_along(tape, p, normalize(Vec3{double(x), double(y), double(z)}), reach));
+          if (const auto t =
+                  nearest_root(tape, p, normalize(Vec3{double(x), double(y), double(z)}), bound))
+            d = std::min(d, std::abs(*t));
   return d;
 }
 
@@ -681,7 +684,8 @@ TriangleMesh polygonize(const Tape& tape, const PolygonizeOptions& options,
                                  std::min(4 * gm.mesh.triangles.size(), budget))) {
           r.face_error = 0;
           for (const auto& t : bisected.triangles)
-            r.face_error = std::max(r.face_error, face_distance(tape, bisected, t, 2 * h, 0));
+            r.face_error =
+                std::max(r.face_error, face_distance(tape, bisected, t, 2 * h, options.error));
           r.bisected = bisected.triangles.size() - gm.mesh.triangles.size();
           if (report) *report = r;
           return bisected;
