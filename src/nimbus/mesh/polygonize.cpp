@@ -458,6 +458,22 @@ GridMesh mesh_grid(const Tape& tape, const Grid& g, double error) {
   return out;
 }
 
+// The 13 directions of the axes and the face and cube diagonals, one of each opposite pair: lines
+// along which a point's distance to the surface is searched besides its normal.
+const std::array<Vec3, 13>& fixed_directions() {
+  static const std::array<Vec3, 13> directions = [] {
+    std::array<Vec3, 13> out;
+    std::size_t k = 0;
+    for (int x = -1; x <= 1; ++x)
+      for (int y = -1; y <= 1; ++y)
+        for (int z = -1; z <= 1; ++z)
+          if (x > 0 || (x == 0 && y > 0) || (x == 0 && y == 0 && z > 0))
+            out[k++] = normalize(Vec3{double(x), double(y), double(z)});
+    return out;
+  }();
+  return directions;
+}
+
 // A point's distance to the surface, tighter than surface_distance where that is above `bound`:
 // the least root along 13 more fixed directions (axes, face and cube diagonals). Along a face's
 // normal, a point on a sharp edge's chamfer may see the far side of the shape first, which
@@ -466,13 +482,10 @@ double tight_distance(const Tape& tape, const Vec3& p, const Vec3& n, double rea
   double d = surface_distance(tape, p, n, reach);
   // Only whether a root lies within the bound matters: each direction is searched that far (a
   // short search, where interval root finding costs most), and the first one found ends it.
-  for (int x = -1; x <= 1 && d > bound; ++x)
-    for (int y = -1; y <= 1 && d > bound; ++y)
-      for (int z = -1; z <= 1 && d > bound; ++z)
-        if (x > 0 || (x == 0 && y > 0) || (x == 0 && y == 0 && z > 0))
-          if (const auto t =
-                  nearest_root(tape, p, normalize(Vec3{double(x), double(y), double(z)}), bound))
-            d = std::min(d, std::abs(*t));
+  for (const Vec3& w : fixed_directions()) {
+    if (d <= bound) break;
+    if (const auto t = nearest_root(tape, p, w, bound)) d = std::min(d, std::abs(*t));
+  }
   return d;
 }
 
@@ -504,11 +517,7 @@ std::vector<double> face_distances(const Tape& tape, const TriangleMesh& mesh, d
 std::optional<Vec3> nearest_surface_point(const Tape& tape, const Vec3& p, const Vec3& n,
                                           double reach) {
   std::vector<Vec3> directions{n, outward(tape, p)};
-  for (int x = -1; x <= 1; ++x)
-    for (int y = -1; y <= 1; ++y)
-      for (int z = -1; z <= 1; ++z)
-        if (x > 0 || (x == 0 && y > 0) || (x == 0 && y == 0 && z > 0))
-          directions.push_back(normalize(Vec3{double(x), double(y), double(z)}));
+  directions.insert(directions.end(), fixed_directions().begin(), fixed_directions().end());
   std::optional<Vec3> best;
   double best_t = reach;
   for (const Vec3& d : directions) {
@@ -527,9 +536,10 @@ std::optional<Vec3> nearest_surface_point(const Tape& tape, const Vec3& p, const
 // whose depth falls only as the cell), a failing face's longest edge is split at its midpoint
 // moved onto the surface, in both faces that share it, so that the mesh stays closed and
 // 2-manifold, until every face is within the bound. Sequential, in the faces' order: the same
-// mesh for any number of threads. False, with the mesh half done, where a midpoint finds no
-// surface within reach or the faces pass max_faces.
-bool bisect_failing_faces(const Tape& tape, TriangleMesh& m, const std::vector<double>& distance,
+// mesh for any number of threads. `distance` holds each face's face_distance, and is kept so for
+// the faces the bisection adds and changes. False, with the mesh half done, where a midpoint finds
+// no surface within reach or the faces pass max_faces.
+bool bisect_failing_faces(const Tape& tape, TriangleMesh& m, std::vector<double>& distance,
                           double error, double reach, std::size_t max_faces) {
   using Face = std::array<std::uint32_t, 3>;
   constexpr std::uint32_t kNone = ~std::uint32_t{0};
@@ -556,7 +566,8 @@ bool bisect_failing_faces(const Tape& tape, TriangleMesh& m, const std::vector<d
   while (!failing.empty()) {
     const std::uint32_t t = failing.front();
     failing.pop_front();
-    if (face_distance(tape, m, m.triangles[t], reach, error) <= error) continue;
+    distance[t] = face_distance(tape, m, m.triangles[t], reach, error);
+    if (distance[t] <= error) continue;
     if (m.triangles.size() + 2 > max_faces) return false;
     // The longest edge, as (a, b) in the face's order, and c the third vertex.
     Face f = m.triangles[t];
@@ -588,6 +599,8 @@ bool bisect_failing_faces(const Tape& tape, TriangleMesh& m, const std::vector<d
     m.triangles.push_back({v, b, c});
     m.triangles[u] = {b, v, d};
     m.triangles.push_back({v, a, d});
+    // Each changed face is measured again when it is taken from the queue.
+    distance.resize(m.triangles.size(), std::numeric_limits<double>::infinity());
     faces_of.erase(key(a, b));
     replace(b, c, t, t1);
     replace(a, d, u, u1);
@@ -680,12 +693,10 @@ TriangleMesh polygonize(const Tape& tape, const PolygonizeOptions& options,
         // Two faces a surface cell: the memory budget's count (kPolygonizeBytesPerCell).
         const std::size_t budget =
             options.max_cells > 0 ? std::size_t(2 * options.max_cells) : ~std::size_t{0};
-        if (bisect_failing_faces(tape, bisected, distance, options.error, 2 * h,
+        std::vector<double> bisected_distance = distance;
+        if (bisect_failing_faces(tape, bisected, bisected_distance, options.error, 2 * h,
                                  std::min(4 * gm.mesh.triangles.size(), budget))) {
-          r.face_error = 0;
-          for (const auto& t : bisected.triangles)
-            r.face_error =
-                std::max(r.face_error, face_distance(tape, bisected, t, 2 * h, options.error));
+          r.face_error = *std::max_element(bisected_distance.begin(), bisected_distance.end());
           r.bisected = bisected.triangles.size() - gm.mesh.triangles.size();
           if (report) *report = r;
           return bisected;
