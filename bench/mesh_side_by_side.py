@@ -12,13 +12,14 @@ process's peak memory (GNU time).
 
   LIBFIVE_SRC=/path/to/libfive LIBFIVE_BUILD=/path/to/libfive/build \\
     /usr/bin/python3 bench/mesh_side_by_side.py [--nimbus build/nimbus] \\
-    [--mesh-error build/mesh_error] [--reps 3] [--errors 0.004,0.001] [SHAPE...]
+    [--mesh-error build/mesh_error] [--reps 3] [--errors 0.004,0.001] [--vs OLD_NIMBUS] [SHAPE...]
 
 LIBFIVE_SRC is a checkout of github.com/libfive/libfive, LIBFIVE_BUILD its CMake build with the
 `five` library built (`cmake -DCMAKE_BUILD_TYPE=Release -DBUILD_STUDIO_APP=OFF
 -DBUILD_GUILE_BINDINGS=OFF -DBUILD_PYTHON_BINDINGS=OFF -DENABLE_DEBUG=OFF`; Debian's
-libeigen3-dev, libboost-dev and libpng-dev). Unset: prints why and exits 0. Shapes: sphere,
-freeform4, cylinder (default: all).
+libeigen3-dev, libboost-dev and libpng-dev). Unset: libfive is left out, and without --vs
+the script prints why and exits 0. --vs adds another nimbus binary (a build from before a
+change), timed interleaved with --nimbus. Shapes: sphere, freeform4, cylinder (default: all).
 """
 import argparse
 import json
@@ -62,8 +63,8 @@ def measure(args, scene, mesh):
     return json.loads(out)
 
 
-def run_nimbus(args, scene, error, threads, mesh):
-    _, err, peak = timed([args.nimbus, "export-mesh", scene, "-o", mesh, "--error", str(error),
+def run_nimbus(args, scene, error, threads, mesh, nimbus):
+    _, err, peak = timed([nimbus, "export-mesh", scene, "-o", mesh, "--error", str(error),
                           "--threads", str(threads)])
     return float(re.search(r" in ([0-9.]+) s ->", err).group(1)), peak
 
@@ -80,22 +81,26 @@ def main():
     ap.add_argument("--reps", type=int, default=3)
     ap.add_argument("--errors", default="0.004,0.001")
     ap.add_argument("--out", default=None, help="work folder (default: a temporary one)")
+    ap.add_argument("--vs", default=None, metavar="NIMBUS",
+                    help="another nimbus binary (a before), timed interleaved with --nimbus")
     ap.add_argument("shapes", nargs="*", default=list(SHAPES))
     args = ap.parse_args()
     src, build = os.environ.get("LIBFIVE_SRC"), os.environ.get("LIBFIVE_BUILD")
-    if not src or not build:
+    if (not src or not build) and not args.vs:
         print("mesh_side_by_side: skipped: set LIBFIVE_SRC and LIBFIVE_BUILD (a libfive checkout "
-              "and its build)", file=sys.stderr)
+              "and its build), or give --vs", file=sys.stderr)
         return 0
     work = args.out or tempfile.mkdtemp(prefix="nimbus-meshes-")
     os.makedirs(work, exist_ok=True)
-    lib = os.path.join(build, "libfive", "src")
-    exe = os.path.join(work, "mesh_libfive")
-    # libfive's own flags: -march=native changes Eigen's alignment, and so the objects' layout.
-    subprocess.run(["g++", "-O3", "-march=native", "-DEIGEN_NO_DEBUG", "-std=c++17",
-                    os.path.join(HERE, "libfive", "mesh_libfive.cpp"),
-                    "-I", os.path.join(src, "libfive", "include"), "-I", "/usr/include/eigen3",
-                    "-L", lib, "-lfive", f"-Wl,-rpath,{lib}", "-o", exe], check=True)
+    exe = None
+    if src and build:
+        lib = os.path.join(build, "libfive", "src")
+        exe = os.path.join(work, "mesh_libfive")
+        # libfive's own flags: -march=native changes Eigen's alignment, and so the objects' layout.
+        subprocess.run(["g++", "-O3", "-march=native", "-DEIGEN_NO_DEBUG", "-std=c++17",
+                        os.path.join(HERE, "libfive", "mesh_libfive.cpp"),
+                        "-I", os.path.join(src, "libfive", "include"), "-I", "/usr/include/eigen3",
+                        "-L", lib, "-lfive", f"-Wl,-rpath,{lib}", "-o", exe], check=True)
     print("| shape | E | mesher | setting | triangles | vertex error | face error | Hausdorff "
           "(samples) | 1 thread (s) | 2 threads (s) | peak memory |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
@@ -109,27 +114,37 @@ def main():
             mesh = os.path.join(work, f"{shape}-nimbus.stl")
             # libfive's coarsest setting within E.
             feature = 2 * half / 4
-            while True:
-                lmesh = os.path.join(work, f"{shape}-libfive.stl")
+            lmesh = os.path.join(work, f"{shape}-libfive.stl")
+            while exe:
                 run_libfive(args, exe, shape, feature, 2, lmesh)
                 m = measure(args, scene, lmesh)
                 if max(m["vertex_error"], m["face_error"]) <= error or feature < error / 64:
                     break
                 feature /= 2
-            # Timed interleaved: nimbus and libfive take turns within each repetition.
-            times, ltimes = {1: [], 2: []}, {1: [], 2: []}
-            peak = lpeak = 0
+            # Timed interleaved: the meshers take turns within each repetition.
+            vmesh = os.path.join(work, f"{shape}-vs.stl")
+            times, ltimes, vtimes = {1: [], 2: []}, {1: [], 2: []}, {1: [], 2: []}
+            peak = lpeak = vpeak = 0
             for _ in range(args.reps):
                 for threads in (1, 2):
-                    t, p = run_nimbus(args, scene, error, threads, mesh)
+                    if args.vs:
+                        t, p = run_nimbus(args, scene, error, threads, vmesh, args.vs)
+                        vtimes[threads].append(t)
+                        vpeak = max(vpeak, p)
+                    t, p = run_nimbus(args, scene, error, threads, mesh, args.nimbus)
                     times[threads].append(t)
                     peak = max(peak, p)
-                    t, p = run_libfive(args, exe, shape, feature, threads, lmesh)
-                    ltimes[threads].append(t)
-                    lpeak = max(lpeak, p)
-            n = measure(args, scene, mesh)
-            for name, setting, r, ts, pk in (("nimbus", f"--error {error:g}", n, times, peak),
-                                             ("libfive", f"min_feature {feature:.3g}", m, ltimes, lpeak)):
+                    if exe:
+                        t, p = run_libfive(args, exe, shape, feature, threads, lmesh)
+                        ltimes[threads].append(t)
+                        lpeak = max(lpeak, p)
+            rows = [("nimbus", f"--error {error:g}", measure(args, scene, mesh), times, peak)]
+            if args.vs:
+                rows.insert(0, ("nimbus (--vs)", f"--error {error:g}", measure(args, scene, vmesh),
+                                vtimes, vpeak))
+            if exe:
+                rows.append(("libfive", f"min_feature {feature:.3g}", m, ltimes, lpeak))
+            for name, setting, r, ts, pk in rows:
                 print(f"| {shape} | {error:g} | {name} | {setting} | {r['triangles']:,} "
                       f"| {r['vertex_error']:.2g} | {r['face_error']:.2g} | {r['hausdorff']:.2g} "
                       f"| {statistics.median(ts[1]):.3f} | {statistics.median(ts[2]):.3f} "
