@@ -30,22 +30,23 @@ void print_warning(const std::string& w) {
   std::fprintf(stderr, "nimbus: warning: %s\n", nimbus::printable_line(w).c_str());
 }
 
-void print_progress(const char* what, double fraction, double elapsed) {
+void print_progress(const char* what, double fraction, double elapsed, const std::string& note) {
   std::lock_guard lock(g_stderr_mutex);
   g_bar_open = true;
   const int width = 40, filled = static_cast<int>(fraction * width);
   const double eta = fraction > 0 ? elapsed * (1 - fraction) / fraction : 0;
-  std::fprintf(stderr, "\r%-8s [%s%s] %5.1f%%  %6.1fs elapsed  ETA %6.1fs", what,
+  std::fprintf(stderr, "\r%-8s [%s%s] %5.1f%%  %6.1fs elapsed  ETA %6.1fs%s", what,
                std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
-               100 * fraction, elapsed, eta);
+               100 * fraction, elapsed, eta, note.c_str());
   std::fflush(stderr);
 }
 
-std::function<void(double)> progress_bar(const char* what) {
+std::function<void(double)> progress_bar(const char* what, std::function<std::string()> note) {
   const auto start = std::chrono::steady_clock::now();
-  return [what, start](double f) {
+  return [what, start, note = std::move(note)](double f) {
     print_progress(what, f,
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+                   note ? note() : std::string());
   };
 }
 

@@ -12,10 +12,11 @@
 void end_bar_line();
 // "nimbus: warning: W" on a line of its own.
 void print_warning(const std::string& w);
-// Draws `what`'s bar at `fraction` done after `elapsed` seconds.
-void print_progress(const char* what, double fraction, double elapsed);
-// A progress callback that draws `what`'s bar, timed from when it is made.
-std::function<void(double)> progress_bar(const char* what);
+// Draws `what`'s bar at `fraction` done after `elapsed` seconds, `note` after it.
+void print_progress(const char* what, double fraction, double elapsed,
+                    const std::string& note = {});
+// A progress callback that draws `what`'s bar, timed from when it is made, with note() after it.
+std::function<void(double)> progress_bar(const char* what, std::function<std::string()> note = {});
 // The objects' compile's bar: drawn only once it has taken half a second (most scenes compile
 // faster), on a line of its own.
 std::function<void(double)> objects_bar();

@@ -45,8 +45,10 @@ struct RenderArgs {
   std::string checkpoint;
   double checkpoint_interval = 0;  // 0: not given (60 s)
   std::string resume;
-  std::string display_server;  // HOST:PORT of a tev viewer; "": none
-  std::string aov;             // AOV names, "albedo,normal"; "": the scene's film.aov
+  std::string display_server;          // HOST:PORT of a tev viewer; "": none
+  std::string aov;                     // AOV names, "albedo,normal"; "": the scene's film.aov
+  std::optional<double> noise_target;  // overrides integrator.noise_target
+  std::optional<int> noise_min_spp;    // overrides integrator.noise_min_spp
 };
 
 // The job's options from the command line's (the parts that are the job's).
@@ -56,6 +58,10 @@ nimbus::RenderJobOptions job_options(const RenderArgs& args) {
   // --aov overrides film.aov, after every --set, as --spp overrides integrator.spp.
   if (!args.aov.empty())
     o.overrides.push_back("film.aov=" + nlohmann::json(comma_separated(args.aov)).dump());
+  if (args.noise_target)
+    o.overrides.push_back(fmt::format("integrator.noise_target={}", *args.noise_target));
+  if (args.noise_min_spp)
+    o.overrides.push_back(fmt::format("integrator.noise_min_spp={}", *args.noise_min_spp));
   o.spp = args.spp;
   o.seed = args.seed;
   o.threads = args.threads;
@@ -164,6 +170,7 @@ int finish_render(const RenderArgs& args, const nimbus::RenderJob& job,
     return failed;
   const RenderSettings& s = job.scene().settings;
   if (r.stopped) {
+    // Of the samples a fixed spp would take: the most a render to a noise target takes.
     const double done = 100 * double(held) / (double(s.width) * s.height * s.spp);
     if (r.checkpoint_failure.empty())
       std::fprintf(stderr,
@@ -209,7 +216,16 @@ int run_render(const RenderArgs& args, const Cluster& cluster) {
     }
   }
   const bool show_progress = lead && !args.quiet && isatty(fileno(stderr));
-  if (show_progress) options.progress = progress_bar("render");
+  if (show_progress) {
+    // With a noise target the bar's fraction is of the samples predicted from the blocks'
+    // errors (its ETA follows the noise's trend), and it shows the share of pixels done.
+    auto converged = std::make_shared<std::atomic<double>>(-1.0);
+    options.noise_progress = [converged](const NoiseProgress& p) { *converged = p.converged; };
+    options.progress = progress_bar("render", [converged] {
+      const double c = *converged;
+      return c < 0 ? std::string() : fmt::format("  {:.1f}% px done", 100 * c);
+    });
+  }
   // The render shown in tev as it refines (io/display_server.h): rank 0's film.
   std::unique_ptr<DisplayServer> display;
   if (!args.display_server.empty()) {
@@ -337,6 +353,17 @@ Command render_command(CLI::App& app) {
                    "comma-separated list of albedo, normal, depth, variance (overrides film.aov; "
                    "docs/cli.md)")
       ->check(aov_names());
+  render
+      ->add_option("--noise-target", args->noise_target,
+                   "Take samples in 8x8 blocks until each block's estimated relative error is at "
+                   "most this, --spp being the most a pixel takes (overrides "
+                   "integrator.noise_target; docs/noise-target.md)")
+      ->check(CLI::Range(0.0, 1.0));
+  render
+      ->add_option("--noise-min-spp", args->noise_min_spp,
+                   "With --noise-target, the samples every block takes before its first decision "
+                   "(overrides integrator.noise_min_spp; default 16)")
+      ->check(integer_in(2));
   render
       ->add_option("--display-server", args->display_server,
                    "Stream the render to a tev viewer at HOST:PORT as it refines (docs/cli.md)")

@@ -32,6 +32,7 @@ struct ViewArgs {
   int port = 8080;
   std::vector<std::string> sets;
   int spp = 0;
+  std::optional<double> noise_target;
   std::optional<uint64_t> seed;
   int threads = 0;
   std::optional<std::string> max_memory;
@@ -92,6 +93,7 @@ int run_view(const ViewArgs& args) {
   options.scene = args.scene;
   options.overrides = args.sets;
   options.spp = args.spp;
+  options.noise_target = args.noise_target;
   options.seed = args.seed;
   options.threads = args.threads;
   if (!(args.mesh_error >= 0 && args.mesh_error <= 0.25)) {
@@ -167,6 +169,10 @@ Command view_command(CLI::App& app) {
                  "can move the camera");
   view->add_option("--spp", args->spp, "Samples per pixel to refine to (default: the scene's)")
       ->check(integer_in(1));
+  view->add_option("--noise-target", args->noise_target,
+                   "Refine each 8x8 block until its estimated relative error is at most this, "
+                   "--spp being the most (overrides integrator.noise_target)")
+      ->check(CLI::Range(0.0, 1.0));
   view->add_option("--seed", args->seed, "Random seed (overrides integrator.seed)")
       ->check(unsigned_64());
   view->add_option("--threads", args->threads, "Worker threads (default: all cores)")

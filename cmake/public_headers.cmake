@@ -44,6 +44,7 @@ set(NIMBUS_PUBLIC_HEADERS
     render/light.h
     render/light_tree.h
     render/material.h
+    render/noise_target.h
     render/renderer.h
     render/scene.h
     render/stats.h

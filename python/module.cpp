@@ -307,10 +307,13 @@ std::shared_ptr<const Scene> compiled_scene(const PyScene& scene, std::optional<
   return compiled;
 }
 
-// A film of the scene's size and light scale (its exponent), for render_into.
+// A film of the scene's size and light scale (its exponent), for render_into; with a noise
+// target, with the half sums its blocks are decided from (render/noise_target.h).
 Film film_of(const PyScene& scene) {
   const auto compiled = compiled_scene(scene, std::nullopt);
-  return Film(compiled->settings.width, compiled->settings.height, compiled->film_exponent);
+  AovSet layers;
+  if (noise_rule(compiled->settings).on()) layers.add(Aov::Half);
+  return Film(compiled->settings.width, compiled->settings.height, compiled->film_exponent, layers);
 }
 
 // Samples [s0, s1) of every pixel into the film; a stopped render leaves the film as it was. The
@@ -541,6 +544,14 @@ PYBIND11_MODULE(_core, m) {
             return f.samples.empty() ? 0u : *std::min_element(f.samples.begin(), f.samples.end());
           })
       .def("image", [](const nimbus::Film& f) { return np::to_array(nimbus::to_image(f)); })
+      .def(
+          "samples",
+          [](const nimbus::Film& f) {
+            py::array_t<uint32_t> a({f.height, f.width});
+            std::copy(f.samples.begin(), f.samples.end(), a.mutable_data());
+            return a;
+          },
+          "Each pixel's sample count, (height, width): with a noise target, its block's.")
       .def("variance",
            [](const nimbus::Film& f) {
              return np::film_array(f, [&](int p) { return f.variance_of_mean(p); });

@@ -274,6 +274,21 @@ TEST(AovFilm, VarianceLayerIsTheFilmsVarianceOfTheMean) {
   EXPECT_GT(largest, 0);
 }
 
+// The samples layer is each pixel's count, from the film's counts: no sums of its own.
+TEST(AovFilm, SamplesLayerIsEachPixelsCount) {
+  Scene scene = shipped("demo", {Aov::Samples}, 4);
+  Film film = make_film(scene);
+  EXPECT_TRUE(film.aov.layers.empty()) << "samples needs no sums of its own";
+  render_into(scene, film, {1, {}, {0, 0, 5, -1, 0, 3}, {}});
+  render_into(scene, film, {1, {}, {5, 0, -1, -1, 0, 4}, {}});
+  const Image image = to_image(film, {Aov::Samples});
+  ASSERT_EQ(image.layers.size(), 1u);
+  EXPECT_EQ(image.layers[0].name, "samples");
+  EXPECT_EQ(image.layers[0].channels, std::vector<std::string>{"N"});
+  for (int p = 0; p < film.pixels(); ++p)
+    EXPECT_EQ(image.layers[0].values[size_t(p)], p % film.width < 5 ? 3.0f : 4.0f);
+}
+
 // Recording draws no number and traces no ray: the colour's sums, its sums of squares and the
 // counters are the bits of a render without AOVs, in scenes with every kind of first vertex
 // (diffuse, glass, emitters, media, the sky; rgb and spectral mode).
@@ -387,7 +402,8 @@ class AovCli : public ::testing::Test {
 
 TEST_F(AovCli, RefusesUnknownAndRepeatedNamesAndPngOutputs) {
   expect_refused("render scene.json -o a.exr --aov albedo,nromal",
-                 "nimbus: --aov: unknown AOV \"nromal\" (one of: albedo, normal, depth, variance)");
+                 "nimbus: --aov: unknown AOV \"nromal\" (one of: albedo, normal, depth, variance, "
+                 "samples)");
   expect_refused("render scene.json -o a.exr --aov depth,depth",
                  "nimbus: --aov: names \"depth\" twice");
   expect_refused("render scene.json -o a.exr -o a.png --aov albedo",
@@ -398,7 +414,7 @@ TEST_F(AovCli, RefusesUnknownAndRepeatedNamesAndPngOutputs) {
                  "to an .exr");
   expect_refused("render scene.json -o a.exr --set 'film.aov=[\"albedo\", \"Depth\"]'",
                  "--set film.aov=[\"albedo\", \"Depth\"]: /film/aov/1: unknown AOV \"Depth\" "
-                 "(expected one of: albedo, normal, depth, variance)");
+                 "(expected one of: albedo, normal, depth, variance, samples)");
 }
 
 TEST_F(AovCli, WritesTheLayersIntoTheExrAlone) {

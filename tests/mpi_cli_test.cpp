@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -100,6 +101,20 @@ TEST_F(Mpi, RanksRenderTheBitsOfOneProcess) {
 
 // The AOVs' sums travel with the pixels (job/film_patch.h) and are exact: albedo, normal and
 // depth on 2 ranks are the bytes of one process without work units.
+// To a noise target a unit carries its lane's state to the rank that continues it
+// (job/work_queue.h): the blocks stop at the same counts with the same bits.
+TEST_F(Mpi, RanksRenderToANoiseTargetTheBitsOfOneProcess) {
+  const std::string target = "--noise-target 0.05 --spp 400 --aov samples ";
+  ASSERT_EQ(nimbus(target + "--threads 2 -o one.exr --checkpoint one.nck").code, 0);
+  const Ran two = mpirun(2, target + "--threads 1 -o two.exr --checkpoint two.nck");
+  ASSERT_EQ(two.code, 0) << two.err;
+  EXPECT_TRUE(same_bytes(dir_ / "two.exr", dir_ / "one.exr"));
+  expect_same_pixels(dir_ / "one.nck", dir_ / "two.nck");
+  const Checkpoint one = load_checkpoint((dir_ / "one.nck").string());
+  const auto [least, most] = std::minmax_element(one.film.samples.begin(), one.film.samples.end());
+  EXPECT_LT(*least, *most);
+}
+
 TEST_F(Mpi, RanksRenderTheAovLayersOfOneProcess) {
   ASSERT_EQ(nimbus("--threads 2 -o one.exr --aov albedo,normal,depth").code, 0);
   const Ran two = mpirun(2, "--threads 1 -o two.exr --aov albedo,normal,depth");

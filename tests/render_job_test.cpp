@@ -158,5 +158,63 @@ TEST_F(Job, ASceneBuiltInCodeResumesUnderItsIdentity) {
   EXPECT_THROW(refused.set_scene(scene, {}), std::invalid_argument);
 }
 
+// To a noise target (render/noise_target.h): the job's passes, its work units with checkpoints,
+// and a checkpoint stopped part way and resumed on other threads, all give the same blocks at the
+// same counts with the same bits; the progress rises to 1 and the pixels done reach all.
+TEST_F(Job, ToANoiseTargetTheSameBitsInPassesInUnitsAndResumed) {
+  const std::vector<std::string> target = {"integrator.noise_target=0.04", "film.width=40",
+                                           "film.height=24"};
+  RenderJobOptions o;
+  o.overrides = target;
+  o.threads = 2;
+  o.spp = 600;
+  std::vector<double> fractions;
+  double converged = 0;
+  o.progress = [&](double f) { fractions.push_back(f); };
+  o.noise_progress = [&](const NoiseProgress& p) { converged = p.converged; };
+  RenderJob passes(o);
+  passes.prepare(scene_);
+  const JobOutcome a = passes.run();
+  ASSERT_FALSE(a.stopped);
+  const auto [least, most] = std::minmax_element(a.film.samples.begin(), a.film.samples.end());
+  EXPECT_EQ(*least, 16u);
+  EXPECT_GT(*most, 100u);
+  EXPECT_LT(samples_held(a.film), uint64_t(40 * 24 * 600) / 2);
+  ASSERT_FALSE(fractions.empty());
+  EXPECT_EQ(fractions.back(), 1.0);
+  EXPECT_EQ(converged, 1.0);
+  EXPECT_EQ(passes.stats(a)["noise_target"]["pixels_done"], 1.0);
+  EXPECT_NE(passes.summary(a).find("noise target 0.04:"), std::string::npos) << passes.summary(a);
+
+  const std::string ck = (dir_ / "noise.nck").string();
+  RenderJobOptions c = o;
+  c.threads = 1;
+  c.checkpoint = ck;
+  c.checkpoint_interval = 0.01;
+  c.progress = {};
+  c.cancel = [&] { return fs::exists(ck); };
+  RenderJob first(c);
+  first.prepare(scene_);
+  const JobOutcome stopped = first.run();
+  ASSERT_TRUE(stopped.stopped);
+  EXPECT_LT(samples_held(stopped.film), samples_held(a.film));
+
+  RenderJobOptions r;
+  r.overrides = target;
+  r.threads = 2;
+  r.resume = ck;
+  RenderJob second(r);
+  second.prepare(scene_);
+  const JobOutcome b = second.run();
+  EXPECT_FALSE(b.stopped);
+  EXPECT_EQ(b.film.samples, a.film.samples);
+  EXPECT_TRUE(b.film.sum == a.film.sum);
+
+  // Resumed to another target: the checkpoint is of other settings.
+  r.overrides[0] = "integrator.noise_target=0.02";
+  RenderJob other(r);
+  EXPECT_THROW(other.prepare(scene_), JobError);
+}
+
 }  // namespace render_job_test
 }  // namespace nimbus

@@ -192,6 +192,29 @@ def test_two_sample_ranges_give_one_renders_bits(tmp_path):
     assert np.array_equal(again.image(), whole) and again.spp == 6
 
 
+def test_a_noise_target_renders_as_the_command_line_and_in_ranges(tmp_path):
+    # Blocks of 8x8 pixels stop where their error meets the target (docs/noise-target.md): the
+    # same pixels from render, from render_into in two ranges, and from nimbus render.
+    target = {**SMALL, "integrator.noise_target": 0.05}
+    scene = nimbus.load_file(DEMO, target)
+    image, stats = nimbus.render(scene, spp=256, seed=3, stats=True)
+    assert stats["noise_target"]["pixels_done"] == 1.0
+    reference = cli_render(tmp_path, DEMO, "--spp", "256", "--seed", "3", "--noise-target",
+                           "0.05", "--set", "film.width=24", "--set", "film.height=16")
+    assert np.array_equal(image, reference)
+    capped = nimbus.load_file(DEMO, {**target, "integrator.spp": 256})
+    film = nimbus.Film(capped)
+    nimbus.render_into(capped, film, samples=(0, 50), seed=3)
+    nimbus.render_into(capped, film, samples=(50, 256), seed=3)
+    assert np.array_equal(film.image(), image)
+    counts = film.samples()
+    assert counts.shape == (16, 24) and counts.dtype == np.uint32
+    assert counts.min() >= 16 and counts.max() > counts.min()
+    assert film.spp == counts.min()
+    with pytest.raises(ValueError, match="go past the spp, 256"):
+        nimbus.render_into(capped, nimbus.Film(capped), samples=(0, 300))
+
+
 def test_films_and_ranges_are_checked():
     scene = nimbus.load_file(DEMO, SMALL)
     other = nimbus.load_file(DEMO, {"film.width": 8, "film.height": 8})

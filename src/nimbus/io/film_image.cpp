@@ -36,7 +36,7 @@ Image to_image(const Film& film, AovSet aovs) {
   const AovSums& a = film.aov;
   for (Aov aov : kAllAovs) {
     if (!aovs.has(aov)) continue;
-    if (aov != Aov::Variance && !a.layers.has(aov))
+    if (aov != Aov::Variance && aov != Aov::Samples && !a.layers.has(aov))
       throw std::invalid_argument(std::string("the film holds no sums of the AOV ") +
                                   std::string(name_of(kAovNames, aov)));
     switch (aov) {
@@ -54,6 +54,12 @@ Image to_image(const Film& film, AovSet aovs) {
       case Aov::Variance:
         img.layers.push_back(
             layer(film, aov, {"R", "G", "B"}, [&](int p) { return film.variance_of_mean(p); }));
+        break;
+      case Aov::Samples:
+        img.layers.push_back(
+            layer(film, aov, {"N"}, [&](int p) { return double(film.samples[p]); }));
+        break;
+      case Aov::Half:
         break;
     }
   }

@@ -9,7 +9,7 @@ namespace nimbus {
 static_assert(std::is_trivially_copyable_v<ExactRgb> && std::is_trivially_copyable_v<Rgb> &&
               std::is_trivially_copyable_v<int128>);
 
-FilmPatch take_patch(Film& film, const PixelRect& r) {
+FilmPatch copy_patch(const Film& film, const PixelRect& r) {
   FilmPatch p;
   p.rect = r;
   p.samples.reserve(r.pixels());
@@ -23,6 +23,15 @@ FilmPatch take_patch(Film& film, const PixelRect& r) {
       p.samples.push_back(film.samples[i]);
       p.sum.push_back(film.sum[i]);
       p.sum_sq.push_back(film.sum_sq[i]);
+    }
+  return p;
+}
+
+FilmPatch take_patch(Film& film, const PixelRect& r) {
+  FilmPatch p = copy_patch(film, r);
+  for (int y = r.y0; y < r.y1; ++y)
+    for (int x = r.x0; x < r.x1; ++x) {
+      const size_t i = size_t(y) * film.width + x;
       film.samples[i] = 0;
       film.sum[i] = ExactRgb{};
       film.sum_sq[i] = Rgb(0.0);

@@ -24,6 +24,8 @@ struct FilmPatch {
   AovSums aov;  // the film's AOV sums, for the rectangle's pixels
 };
 
+// The rectangle's pixels of `film`.
+FilmPatch copy_patch(const Film& film, const PixelRect& rect);
 // Moves the rectangle's pixels out of `film` (which then holds no samples there).
 FilmPatch take_patch(Film& film, const PixelRect& rect);
 

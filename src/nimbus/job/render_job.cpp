@@ -10,6 +10,7 @@
 #include "nimbus/job/fingerprint.h"
 #include "nimbus/job/shared_render.h"
 #include "nimbus/render/memory_estimate.h"
+#include "nimbus/render/noise_target.h"
 #include "nimbus/render/path_spectra.h"
 #include "nimbus/render/renderer.h"
 #include "nimbus/render/stats.h"
@@ -75,9 +76,15 @@ void RenderJob::set_scene(Scene scene, const nlohmann::json& identity) {
   const int spp = read_resume();
   scene_ = std::move(scene);
   if (spp > 0) scene_.settings.spp = spp;
-  fingerprint_ = render_fingerprint(nlohmann::json{{"scene", identity},
-                                                   {"seed", scene_.settings.seed},
-                                                   {"max_depth", scene_.settings.max_depth}});
+  nlohmann::json of{{"scene", identity},
+                    {"seed", scene_.settings.seed},
+                    {"max_depth", scene_.settings.max_depth}};
+  // Where blocks stop (render/noise_target.h); absent without one, as before it existed.
+  if (scene_.settings.noise_target > 0) {
+    of["noise_target"] = scene_.settings.noise_target;
+    of["noise_min_spp"] = scene_.settings.noise_min_spp;
+  }
+  fingerprint_ = render_fingerprint(of);
   compiled_ = true;
   check();
   check_compiled();
@@ -87,7 +94,7 @@ void RenderJob::check() const {
   const int width = compiled_ ? scene_.settings.width : desc_.settings.width;
   const int height = compiled_ ? scene_.settings.height : desc_.settings.height;
   const int spp = compiled_ ? scene_.settings.spp : desc_.settings.spp;
-  const AovSet aovs = compiled_ ? scene_.settings.aovs : desc_.settings.aovs;
+  const AovSet aovs = film_aovs(compiled_ ? scene_.settings : desc_.settings);
   if (resumed_) {
     const std::string& file = options_.resume;
     // The document and the settings now; the files it reads once they are read (check_compiled).
@@ -159,7 +166,7 @@ JobOutcome RenderJob::run(JobChannel* channel) {
   // One call of the renderer, over tiles, unless units must be shared or checkpointed; shown
   // alone, the render goes in passes of samples.
   if (!channel && checkpoint_file_.empty())
-    return options_.display ? run_in_passes() : run_at_once();
+    return options_.display || noise_rule(scene_.settings).on() ? run_in_passes() : run_at_once();
   return run_shared(channel);
 }
 
@@ -184,18 +191,23 @@ JobOutcome RenderJob::run_in_passes() {
   // issue 28). Passes grow until one lasts half a second, the display's interval; the film after
   // each is the image so far, and at the end the bits of one call, since the exact sums do not
   // depend on the split.
+  // With a noise target, blocks that are done take no more samples (render/noise_target.h), the
+  // render ends once all are, and the progress is the share of the samples predicted from the
+  // blocks' errors.
   constexpr double kDisplayInterval = 0.5;
   const int spp = scene_.settings.spp;
+  const NoiseRule rule = noise_rule(scene_.settings);
   JobOutcome outcome;
   outcome.film = make_film(scene_);
   int done = 0, pass = 1;
+  NoiseProgress noise;
   while (done < spp) {
     RenderOptions o;
     o.threads = options_.threads;
     o.cancel = options_.cancel;
     o.range.s0 = done;
     o.range.s1 = std::min(spp, done + pass);
-    if (options_.progress)
+    if (options_.progress && !rule.on())
       o.progress = [&, s0 = done, n = o.range.s1 - done](double f) {
         options_.progress((s0 + f * n) / spp);
       };
@@ -209,7 +221,13 @@ JobOutcome RenderJob::run_in_passes() {
     }
     done = o.range.s1;
     pass = std::clamp(int(pass * kDisplayInterval / std::max(r.seconds, 1e-3)), 1, 2 * pass);
-    if (done < spp) options_.display(outcome.film);
+    if (rule.on()) {
+      noise = noise_progress(rule, outcome.film);
+      if (options_.noise_progress) options_.noise_progress(noise);
+      if (options_.progress) options_.progress(noise.converged < 1 ? noise.fraction : 1.0);
+      if (noise.converged >= 1) break;
+    }
+    if (done < spp && options_.display) options_.display(outcome.film);
   }
   return outcome;
 }
@@ -247,6 +265,7 @@ JobOutcome RenderJob::run_shared(JobChannel* channel) {
     };
   }
   s.progress = options_.progress;
+  s.noise_progress = options_.noise_progress;
   s.stop = options_.cancel;
   SharedRenderResult r = lead_shared_render(scene_, channel, std::move(s));
   JobOutcome outcome;
@@ -291,7 +310,16 @@ std::string RenderJob::summary(const JobOutcome& outcome) const {
   const double samples = double(samples_held(outcome.film) - outcome.samples_at_start);
   std::string where = fmt::format("{} threads", outcome.threads);
   if (outcome.processes > 1) where += fmt::format(" x {} processes", outcome.processes);
-  return fmt::format("{}x{}, {} spp in {:.2f} s ({:.3g} samples/s, {})", s.width, s.height, s.spp,
+  std::string spp = fmt::format("{} spp", s.spp);
+  if (const NoiseRule rule = noise_rule(s); rule.on()) {
+    const NoiseProgress p = noise_progress(rule, outcome.film);
+    spp = fmt::format(
+        "noise target {:g}: {:.1f} spp on average, at most {}, {:.1f} % of pixels at "
+        "the target",
+        rule.target, double(samples_held(outcome.film)) / outcome.film.pixels(), s.spp,
+        100 * (p.converged - p.capped));
+  }
+  return fmt::format("{}x{}, {} in {:.2f} s ({:.3g} samples/s, {})", s.width, s.height, spp,
                      outcome.seconds, outcome.seconds > 0 ? samples / outcome.seconds : 0.0, where);
 }
 
@@ -334,8 +362,9 @@ void check_render_memory(const SceneDesc& desc, int threads, std::optional<uint6
   const int bins =
       desc.settings.spectral.mode == SpectralSettings::Mode::Spectral ? kSpectralBins : 3;
   const int workers = threads > 0 ? threads : int(std::thread::hardware_concurrency());
-  MemoryEstimate need = estimate_render_memory(desc.settings.width, desc.settings.height, octrees,
-                                               bins, workers, field_objects, desc.settings.aovs);
+  MemoryEstimate need =
+      estimate_render_memory(desc.settings.width, desc.settings.height, octrees, bins, workers,
+                             field_objects, film_aovs(desc.settings));
   need.objects = object_memory(desc);
   const uint64_t limit = max_memory ? *max_memory : available_memory();
   if (limit > 0 && need.total() > double(limit))

@@ -28,6 +28,7 @@
 #include "nimbus/media/build_monitor.h"
 #include "nimbus/render/counters.h"
 #include "nimbus/render/film.h"
+#include "nimbus/render/noise_target.h"
 #include "nimbus/render/scene.h"
 #include "nimbus/scene/scene_desc.h"
 
@@ -56,10 +57,15 @@ struct RenderJobOptions {
   // (io/display_server.h). Set, the job renders in passes of samples over the whole film (in
   // units with checkpoints or processes); the caller shows the outcome's film at the end.
   std::function<void(const Film&)> display;
+  // With a noise target, called now and then with the share of pixels done and of the samples
+  // predicted (render/noise_target.h).
+  std::function<void(const NoiseProgress&)> noise_progress;
 };
 
 struct JobOutcome {
-  Film film;  // every pixel at spp, or stopped: the samples done (whole units with checkpoints)
+  // Every pixel at spp (with a noise target, each block done), or stopped: the samples done
+  // (whole units with checkpoints).
+  Film film;
   Counters counters;
   double seconds = 0;
   int threads = 0;  // per process

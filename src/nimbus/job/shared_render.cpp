@@ -10,6 +10,7 @@
 
 #include "nimbus/job/film_patch.h"
 #include "nimbus/job/work_queue.h"
+#include "nimbus/render/noise_target.h"
 #include "nimbus/render/renderer.h"
 
 namespace nimbus {
@@ -56,8 +57,9 @@ struct Reader {
   }
 };
 
-// A unit's render into `scratch` (which holds no samples in the unit's pixels), cancelled
-// when `stop` says so; the result is moved out of the scratch film.
+// A unit's render into `scratch` (which holds no samples in the unit's pixels, or with a noise
+// target the lane's state), cancelled when `stop` says so; the result is moved out of the
+// scratch film.
 struct UnitResult {
   FilmPatch patch;
   RenderStats stats;
@@ -116,6 +118,10 @@ void serve(WorkQueue& queue, JobChannel* channel, const SharedRenderSettings& s,
       if (const std::optional<WorkUnit> u = queue.try_next()) {
         out.put(Reply::Unit);
         out.put(*u);
+        if (queue.noise_target()) {
+          const std::vector<std::byte> state = pack_patch(queue.lane_state(*u));
+          out.append(state.data(), state.size());
+        }
       } else if (over) {
         out.put(Reply::Done);
         ++gone;
@@ -126,8 +132,17 @@ void serve(WorkQueue& queue, JobChannel* channel, const SharedRenderSettings& s,
       channel->send(*it, kReplyTag, out.bytes);
       it = waiting.erase(it);
     }
-    if (s.progress && seconds_since(last_progress) > 0.1) {
-      s.progress(queue.fraction_done());
+    // With a noise target, the share of the predicted samples, and of the pixels done
+    // (render/noise_target.h): a pass over the film's blocks, so twice a second.
+    if (s.progress && seconds_since(last_progress) > (queue.noise_target() ? 0.5 : 0.1)) {
+      if (queue.noise_target() && s.noise_progress) {
+        NoiseProgress p;
+        queue.with_film([&](const Film& film) { p = noise_progress(s.noise, film); });
+        s.noise_progress(p);
+        s.progress(queue.finished() ? 1.0 : p.fraction);
+      } else {
+        s.progress(queue.fraction_done());
+      }
       last_progress = Clock::now();
     }
     if (s.display && !over && seconds_since(last_display) >= s.display_interval) {
@@ -153,7 +168,8 @@ SharedRenderResult lead_shared_render(const Scene& scene, JobChannel* channel,
   // Four bands per rank at least, so every rank has lanes to take; at most 16 rows (the
   // renderer's tile), so the bands of a dense region are short.
   const int band_height = std::clamp(H / (4 * ranks), 1, 16);
-  WorkQueue queue(std::move(s.start), s.spp, band_height, ranks, s.unit_seconds);
+  s.noise = noise_rule(scene.settings);
+  WorkQueue queue(std::move(s.start), s.spp, band_height, ranks, s.unit_seconds, s.noise);
   // An exception on either thread ends the job: the other stops at its next pixel or poll, and
   // the exception leaves this function.
   std::atomic<bool> failed{false};
@@ -164,6 +180,7 @@ SharedRenderResult lead_shared_render(const Scene& scene, JobChannel* channel,
     try {
       Film scratch = make_film(scene);
       while (const std::optional<WorkUnit> u = queue.wait_next()) {
+        if (queue.noise_target()) merge_patch(scratch, queue.lane_state(*u));
         const UnitResult r = render_unit(scene, scratch, *u, s.threads, stop);
         if (r.stats.cancelled)
           queue.abandon(*u);
@@ -211,6 +228,8 @@ void work_on_shared_render(const Scene& scene, JobChannel& channel, int threads,
     Reader in{m.bytes};
     if (in.get<Reply>() == Reply::Done) return;
     const auto unit = in.get<WorkUnit>();
+    // With a noise target the lane's state follows, which the unit continues (work_queue.h).
+    if (!in.bytes.empty()) merge_patch(scratch, unpack_patch(in.bytes));
     const UnitResult r = render_unit(scene, scratch, unit, threads, stop);
     report = {};
     if (r.stats.cancelled) {

@@ -11,6 +11,7 @@
 #include "nimbus/job/job_channel.h"
 #include "nimbus/render/counters.h"
 #include "nimbus/render/film.h"
+#include "nimbus/render/noise_target.h"
 #include "nimbus/render/scene.h"
 
 namespace nimbus {
@@ -29,7 +30,10 @@ struct SharedRenderSettings {
   std::function<void(const Film&)> display;
   double display_interval = 0.25;
   std::function<void(double)> progress;  // fraction of the job done, on the lead
-  std::function<bool()> stop;            // polled; true: stop handing out and rendering units
+  // With a noise target, the film's progress towards it, on the lead, with `progress`.
+  std::function<void(const NoiseProgress&)> noise_progress;
+  NoiseRule noise;             // set by lead_shared_render from the scene
+  std::function<bool()> stop;  // polled; true: stop handing out and rendering units
 };
 
 struct SharedRenderResult {

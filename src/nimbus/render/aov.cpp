@@ -29,6 +29,7 @@ void AovSums::add(size_t pixel, const AovSums& from, size_t from_pixel) {
     depth[pixel] += from.depth[from_pixel];
     depth_samples[pixel] += from.depth_samples[from_pixel];
   }
+  if (layers.has(Aov::Half)) half[pixel] += from.half[from_pixel];
 }
 
 void AovSums::clear(size_t pixel) {
@@ -61,7 +62,7 @@ size_t aov_film_bytes(AovSet aovs) {
 int aov_image_floats(AovSet aovs) {
   int floats = 0;
   for (Aov a : kAllAovs)
-    if (aovs.has(a)) floats += a == Aov::Depth ? 1 : 3;
+    if (aovs.has(a)) floats += a == Aov::Depth || a == Aov::Samples ? 1 : 3;
   return floats;
 }
 

@@ -2,7 +2,11 @@
 // AOVs (arbitrary output variables): per-pixel layers written beside the colour, for denoisers
 // such as OIDN (docs/denoising.md). Albedo, normal and depth come from what each camera path met
 // first (FirstVertex, recorded by trace_path) and are averaged over the pixel's samples as the
-// colour is; variance is the colour's own variance of the mean (Film::variance_of_mean).
+// colour is; variance is the colour's own variance of the mean (Film::variance_of_mean); samples
+// is each pixel's sample count (a render to a noise target gives pixels different counts).
+//
+// One more layer is recorded but never written: Half, the sum of one sample of each pair, which a
+// render to a noise target estimates its error from (render/noise_target.h).
 //
 // The sums are exact, as the colour's (render/exact_sum.h): a film's layers are the same bits
 // however its samples were split between threads, calls or processes and merged.
@@ -21,8 +25,10 @@ namespace nimbus {
 
 // In the order of an image's layers (io/film_image.h) and of the docs; names in
 // render/setting_names.h.
-enum class Aov : uint8_t { Albedo, Normal, Depth, Variance };
-inline constexpr Aov kAllAovs[] = {Aov::Albedo, Aov::Normal, Aov::Depth, Aov::Variance};
+enum class Aov : uint8_t { Albedo, Normal, Depth, Variance, Samples, Half };
+// The layers an image can have, in order; Half is the film's alone.
+inline constexpr Aov kAllAovs[] = {Aov::Albedo, Aov::Normal, Aov::Depth, Aov::Variance,
+                                   Aov::Samples};
 
 class AovSet {
  public:
@@ -39,10 +45,11 @@ class AovSet {
     s.bits_ = bits;
     return s;
   }
-  // The AOVs whose sums a film holds: all but variance, which the colour's sums give.
+  // The AOVs whose sums a film holds: all but variance and samples, which the colour's sums and
+  // counts give.
   constexpr AovSet recorded() const {
-    return from_bits(
-        uint8_t(bits_ & (1u << int(Aov::Albedo) | 1u << int(Aov::Normal) | 1u << int(Aov::Depth))));
+    return from_bits(uint8_t(bits_ & (1u << int(Aov::Albedo) | 1u << int(Aov::Normal) |
+                                      1u << int(Aov::Depth) | 1u << int(Aov::Half))));
   }
   bool operator==(const AovSet&) const = default;
 
@@ -60,8 +67,8 @@ struct FirstVertex {
   double depth = std::numeric_limits<double>::infinity();
 };
 
-// The per-pixel sums of a film's recorded AOVs (albedo, normal, depth), allocated only for those
-// asked for.
+// The per-pixel sums of a film's recorded AOVs (albedo, normal, depth, half), allocated only for
+// those asked for.
 struct AovSums {
   AovSet layers;  // recorded AOVs only
   // Depths are summed in units of 2^(depth_exponent - 64), an exponent on the scale of the
@@ -70,6 +77,9 @@ struct AovSums {
   std::vector<ExactRgb> albedo, normal;
   std::vector<int128> depth;
   std::vector<uint32_t> depth_samples;  // samples whose camera ray met something
+  // Half: of each pair of samples (2k, 2k + 1), the one in_half picks (render/noise_target.h),
+  // summed exactly in the film's units (Film::exponent).
+  std::vector<ExactRgb> half;
 
   AovSums() = default;
   AovSums(AovSet aovs, size_t pixels, int depth_exponent_);
@@ -106,6 +116,7 @@ struct AovSums {
       f(s.depth);
       f(s.depth_samples);
     }
+    if (s.layers.has(Aov::Half)) f(s.half);
   }
 };
 

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "nimbus/render/noise_target.h"
 #include "nimbus/render/wavelength_counts.h"
 
 namespace nimbus {
@@ -17,6 +18,43 @@ RenderStats render_channels(const Scene& scene, Film& film, const RenderRange& r
                             const RenderOptions& options, int threads);
 
 namespace {
+
+// With a noise target: the range covers whole blocks, whose samples start at 0 (their
+// decisions read every sample), and each block holds range.s0 samples or is done with fewer.
+RenderRange resolve_blocks(const NoiseRule& rule, const Film& film, const RenderRange& r) {
+  const int W = film.width, H = film.height;
+  if (!film.aov.layers.has(Aov::Half))
+    throw std::invalid_argument(
+        "with a noise target, the film must hold the half sums its error is estimated from: a "
+        "film made for the scene (make_film)");
+  const auto edge = [](int v, int size) { return v % kNoiseBlock == 0 || v == size; };
+  if (r.x0 % kNoiseBlock != 0 || r.y0 % kNoiseBlock != 0 || !edge(r.x1, W) || !edge(r.y1, H))
+    throw std::invalid_argument(fmt::format(
+        "with a noise target, pixels [{}, {}) x [{}, {}) must cover whole {}x{} blocks (starting "
+        "at multiples of {})",
+        r.x0, r.x1, r.y0, r.y1, kNoiseBlock, kNoiseBlock, kNoiseBlock));
+  if (r.s1 > rule.cap)
+    throw std::invalid_argument(fmt::format(
+        "with a noise target, samples [{}, {}) go past the spp, {}", r.s0, r.s1, rule.cap));
+  for (int by = r.y0 / kNoiseBlock; by * kNoiseBlock < r.y1; ++by)
+    for (int bx = r.x0 / kNoiseBlock; bx * kNoiseBlock < r.x1; ++bx) {
+      const NoiseBlock b = noise_block(film, bx, by);
+      const uint32_t held = film.samples[size_t(b.y0) * W + b.x0];
+      for (int y = b.y0; y < b.y1; ++y)
+        for (int x = b.x0; x < b.x1; ++x)
+          if (film.samples[size_t(y) * W + x] != held)
+            throw std::invalid_argument(fmt::format(
+                "with a noise target, the pixels of the block at ({}, {}) must hold one count: "
+                "({}, {}) holds {}, ({}, {}) {}",
+                b.x0, b.y0, b.x0, b.y0, held, x, y, film.samples[size_t(y) * W + x]));
+      if (held == uint32_t(r.s0) || (held < uint32_t(r.s0) && block_done(rule, film, b))) continue;
+      throw std::invalid_argument(fmt::format(
+          "with a noise target, the block at ({}, {}) holds {} samples; samples [{}, {}) continue "
+          "from {} (or from fewer, where the block is done)",
+          b.x0, b.y0, held, r.s0, r.s1, r.s0));
+    }
+  return r;
+}
 
 // The range with its open ends resolved, checked against the film.
 RenderRange resolve(const Scene& scene, const Film& film, RenderRange r) {
@@ -47,6 +85,8 @@ RenderRange resolve(const Scene& scene, const Film& film, RenderRange r) {
                                             r.x1, r.y0, r.y1, W, H));
   if (r.s0 < 0 || r.s0 > r.s1)
     throw std::invalid_argument(fmt::format("samples [{}, {}) are not a range", r.s0, r.s1));
+  const NoiseRule rule = noise_rule(scene.settings);
+  if (rule.on()) return resolve_blocks(rule, film, r);
   for (int y = r.y0; y < r.y1; ++y)
     for (int x = r.x0; x < r.x1; ++x)
       if (const uint32_t held = film.samples[size_t(y) * W + x];

@@ -214,9 +214,15 @@ int depth_exponent(const Scene& scene) {
   return film_exponent(scene.scale + length(scene.camera.origin));
 }
 
+AovSet film_aovs(const RenderSettings& settings) {
+  AovSet aovs = settings.aovs;
+  if (settings.noise_target > 0) aovs.add(Aov::Half);
+  return aovs;
+}
+
 Film make_film(const Scene& scene) {
-  return Film(scene.settings.width, scene.settings.height, scene.film_exponent, scene.settings.aovs,
-              depth_exponent(scene));
+  return Film(scene.settings.width, scene.settings.height, scene.film_exponent,
+              film_aovs(scene.settings), depth_exponent(scene));
 }
 
 void complete_spectra(Scene& scene) {

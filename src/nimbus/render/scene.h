@@ -58,7 +58,7 @@ struct RenderSettings {
   // phase sampling while another light shines (render/light_choice.h).
   enum class LightSampling { All, One };
   int width = 640, height = 480;
-  int spp = 16;
+  int spp = 16;  // with a noise target, the most samples a pixel takes
   uint64_t seed = 0;
   int max_depth = 1000;
   TrackingSettings tracking;
@@ -71,6 +71,10 @@ struct RenderSettings {
   // surfaces, which BSDF sampling finds too; point and directional lights always have them.
   bool manifold_area_caustics = true;
   AovSet aovs = {};  // the layers written beside the colour (render/aov.h)
+  // > 0: pixels take samples, in blocks, until their relative error is at most this
+  // (render/noise_target.h); 0: every pixel takes spp.
+  double noise_target = 0;
+  int noise_min_spp = 16;  // the samples every block takes before its first decision
 };
 
 struct MicrofacetAlbedoLevels;
@@ -164,8 +168,11 @@ double brightest_emission(const Scene& scene);
 // camera's distance from the origin, the scale of the distances its camera rays meet things at.
 int depth_exponent(const Scene& scene);
 
-// A fresh film for the scene: its image's size, its film exponent and its AOV layers.
+// A fresh film for the scene: its image's size, its film exponent and its layers (film_aovs).
 Film make_film(const Scene& scene);
+// The layers a film of these settings holds: the AOVs asked for, and Half for a noise target
+// (render/noise_target.h).
+AovSet film_aovs(const RenderSettings& settings);
 
 // Gives every colour input of the scene its spectral curve (spectral_param.h), by role; spectral
 // mode needs them, rgb mode ignores them. Call before build_majorant_octrees.

@@ -42,11 +42,12 @@ inline constexpr std::array<std::pair<std::string_view, RenderSettings::LightSam
     kLightSamplingNames = {
         {{"all", RenderSettings::LightSampling::All}, {"one", RenderSettings::LightSampling::One}}};
 
-inline constexpr std::array<std::pair<std::string_view, Aov>, 4> kAovNames = {
+inline constexpr std::array<std::pair<std::string_view, Aov>, 5> kAovNames = {
     {{"albedo", Aov::Albedo},
      {"normal", Aov::Normal},
      {"depth", Aov::Depth},
-     {"variance", Aov::Variance}}};
+     {"variance", Aov::Variance},
+     {"samples", Aov::Samples}}};
 
 // The name of a value in its table.
 template <class E, size_t K>

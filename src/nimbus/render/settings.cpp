@@ -100,8 +100,18 @@ std::vector<Setting> make_settings() {
       aov_list("film.aov",
                "AOV layers written into the EXR beside the colour, for denoisers (as `--aov`)"),
       integer(
-          "integrator.spp", at_least(1), "samples per pixel",
+          "integrator.spp", at_least(1),
+          "samples per pixel; with a noise target, the most a pixel takes",
           [](auto& s) -> auto& { return s.spp; }),
+      number(
+          "integrator.noise_target", between(0, 1),
+          "> 0: each 8 × 8 block of pixels takes samples until its estimated relative error is at "
+          "most this, or spp (as `--noise-target`; docs/noise-target.md); 0: every pixel takes spp",
+          [](auto& s) -> auto& { return s.noise_target; }),
+      integer(
+          "integrator.noise_min_spp", at_least(2),
+          "with a noise target, the samples every block takes before its error is first estimated",
+          [](auto& s) -> auto& { return s.noise_min_spp; }),
       seed,
       integer(
           "integrator.max_depth", at_least(1),

@@ -1,7 +1,9 @@
 #include "nimbus/render/stats.h"
 
 #include <algorithm>
+#include <numeric>
 
+#include "nimbus/render/noise_target.h"
 #include "nimbus/render/settings.h"
 
 namespace nimbus {
@@ -75,6 +77,18 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
                  {"depth_requested", scene.settings.tracking.octree_depth},
                  {"depth", depth},
                  {"sampled_points", sampled}};
+  if (const NoiseRule rule = noise_rule(scene.settings); rule.on()) {
+    const NoiseProgress p = noise_progress(rule, result.film);
+    const auto most = std::max_element(result.film.samples.begin(), result.film.samples.end());
+    j["noise_target"] = {
+        {"target", rule.target},
+        {"min_spp", rule.min_spp},
+        {"pixels_done", p.converged},
+        {"pixels_at_cap_above_target", p.capped},
+        {"mean_spp", std::accumulate(result.film.samples.begin(), result.film.samples.end(), 0.0) /
+                         std::max(1, result.film.pixels())},
+        {"max_spp", most != result.film.samples.end() ? *most : 0u}};
+  }
   return j;
 }
 

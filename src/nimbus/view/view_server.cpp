@@ -143,6 +143,7 @@ struct ViewServer::Impl {
             {"samples_per_second", f.samples_per_second},
             {"elapsed", f.elapsed},
             {"noise", f.noise},
+            {"pixels_done", f.pixels_done},
             {"error", f.error},
             {"loads", f.loads},
             {"restarts", f.restarts},

@@ -1,10 +1,12 @@
 #include "nimbus/view/view_session.h"
 
+#include <fmt/format.h>
 #include <sys/stat.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include "nimbus/io/film_image.h"
 #include "nimbus/job/render_job.h"
@@ -103,6 +105,8 @@ bool ViewSession::load() {
   try {
     std::vector<std::string> overrides = options_.overrides;
     if (options_.seed) overrides.push_back("integrator.seed=" + std::to_string(*options_.seed));
+    if (options_.noise_target)
+      overrides.push_back(fmt::format("integrator.noise_target={}", *options_.noise_target));
     SceneDesc desc = load_scene_file(options_.scene, overrides);
     if (options_.spp > 0) desc.settings.spp = options_.spp;
     check_render_memory(desc, options_.threads, options_.max_memory);
@@ -164,6 +168,7 @@ void ViewSession::restart(Clock::time_point now) {
   frame_.target_spp = scene_->settings.spp;
   frame_.samples_per_second = 0;
   frame_.noise = 0;
+  frame_.pixels_done = noise_rule(scene_->settings).on() ? 0 : -1;
   frame_.camera = camera_;
   ++frame_.restarts;
 }
@@ -171,7 +176,10 @@ void ViewSession::restart(Clock::time_point now) {
 void ViewSession::publish(std::shared_ptr<const Image> image, bool preview) {
   const double elapsed = std::chrono::duration<double>(Clock::now() - restarted_).count();
   const double noise = preview ? 0 : view_noise(film_);
+  const NoiseRule rule = noise_rule(scene_->settings);
+  const double pixels_done = rule.on() ? noise_progress(rule, film_).converged : -1;
   std::lock_guard lock(mutex_);
+  frame_.pixels_done = pixels_done;
   ++frame_.version;
   frame_.image = std::move(image);
   frame_.preview = preview;
@@ -198,12 +206,20 @@ void ViewSession::render_pass() {
   ro.range.s0 = spp_;
   ro.range.s1 = std::min(scene_->settings.spp, spp_ + pass_spp_);
   ro.cancel = [this] { return interrupt_.load(std::memory_order_relaxed); };
+  const auto held = [&] {
+    return std::accumulate(film_.samples.begin(), film_.samples.end(), uint64_t(0));
+  };
+  const uint64_t before = held();
   const RenderStats stats = render_into(*scene_, film_, ro);
   // A cancelled pass leaves pixels at two sample counts: start again.
   if (stats.cancelled) return restart(Clock::now());
-  const int done = ro.range.s1 - ro.range.s0;
   spp_ = ro.range.s1;
-  samples_ += uint64_t(done) * uint64_t(film_.pixels());
+  // With a noise target, blocks that are done took none of the pass's samples, and once all
+  // are the film is finished: refining stops (render/noise_target.h).
+  samples_ += held() - before;
+  if (const NoiseRule rule = noise_rule(scene_->settings);
+      rule.on() && noise_progress(rule, film_).converged >= 1)
+    spp_ = scene_->settings.spp;
   render_seconds_ += stats.seconds;
   pass_spp_ =
       std::clamp(int(pass_spp_ * kPassSeconds / std::max(stats.seconds, 1e-3)), 1, 2 * pass_spp_);

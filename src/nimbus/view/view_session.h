@@ -34,6 +34,7 @@ struct ViewOptions {
   std::string scene;                   // the scene file
   std::vector<std::string> overrides;  // --set KEY=VALUE, in order
   int spp = 0;                         // > 0: refine to this many samples; 0: the scene's spp
+  std::optional<double> noise_target;  // overrides integrator.noise_target
   std::optional<uint64_t> seed;        // overrides integrator.seed
   int threads = 0;                     // 0: all cores
   std::optional<uint64_t> max_memory;  // bytes; none: the memory the system has available
@@ -57,6 +58,8 @@ struct ViewFrame {
   double samples_per_second = 0;            // pixel samples, since the last restart
   double elapsed = 0;                       // seconds since the last restart
   double noise = 0;                         // view_noise of the film
+  // With a noise target (render/noise_target.h): the share of pixels done; -1 without one.
+  double pixels_done = -1;
   std::string error;      // why the scene file last failed to load; "" if it loaded
   uint64_t loads = 0;     // successful loads of the scene file
   uint64_t restarts = 0;  // camera moves and loads that restarted the render

@@ -164,7 +164,9 @@ function show(s) {
   $('scene').textContent = s.scene;
   $('error').hidden = s.error === '';
   $('error').textContent = s.error;
-  $('spp').textContent = `${s.spp} / ${s.target_spp}`;
+  // With a noise target, the share of pixels whose blocks are done.
+  $('spp').textContent = `${s.spp} / ${s.target_spp}` +
+    (s.pixels_done >= 0 ? ` (${(100 * s.pixels_done).toFixed(0)} % of pixels done)` : '');
   $('sps').textContent = s.samples_per_second > 0 ? s.samples_per_second.toExponential(2) : '–';
   $('elapsed').textContent = `${s.elapsed.toFixed(1)} s`;
   $('noise').textContent = s.noise > 0 ? `${(100 * s.noise).toFixed(2)} %` : '–';
