@@ -5,8 +5,8 @@
 // colour is; variance is the colour's own variance of the mean (Film::variance_of_mean); samples
 // is each pixel's sample count (a render to a noise target gives pixels different counts).
 //
-// One more layer is recorded but never written: Half, the sum of one sample of each pair, which a
-// render to a noise target estimates its error from (render/noise_target.h).
+// One more layer is recorded but never written: Half, the sum of the odd samples, which a render
+// to a noise target estimates its error from (render/noise_target.h).
 //
 // The sums are exact, as the colour's (render/exact_sum.h): a film's layers are the same bits
 // however its samples were split between threads, calls or processes and merged.
@@ -77,8 +77,8 @@ struct AovSums {
   std::vector<ExactRgb> albedo, normal;
   std::vector<int128> depth;
   std::vector<uint32_t> depth_samples;  // samples whose camera ray met something
-  // Half: of each pair of samples (2k, 2k + 1), the one in_half picks (render/noise_target.h),
-  // summed exactly in the film's units (Film::exponent).
+  // Half: the odd samples (in_half, render/noise_target.h), summed again exactly in the film's
+  // units (Film::exponent).
   std::vector<ExactRgb> half;
 
   AovSums() = default;

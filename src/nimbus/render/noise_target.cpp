@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "nimbus/math/rng.h"
 #include "nimbus/render/scene.h"
 
 namespace nimbus {
@@ -33,11 +32,6 @@ bool is_pass_end(const NoiseRule& rule, int n) {
   int end = n0;
   while (end < n) end += std::max(n0, 2 * (end / 8));
   return end == n;
-}
-
-bool in_half(uint64_t seed, uint64_t pixel, uint64_t s) {
-  return (splitmix64(splitmix64(seed ^ 0x5bd1e995ull) ^ splitmix64(pixel) ^ (s >> 1)) & 1) ==
-         (s & 1);
 }
 
 NoiseBlock noise_block(const Film& film, int bx, int by) {

@@ -9,13 +9,14 @@
 // the same count, with the same bits, however its samples were split between threads, calls,
 // work units, processes and resumed checkpoints: the image stays deterministic.
 //
-// The error. Of each pair of samples (2k, 2k + 1) of a pixel, one, picked by a hash of (seed,
-// pixel, k), is also summed into the film's Half layer. With n (even) samples, the means a of
-// that half and b of the other differ by d = a − b with E[d²] = (4/n²) Σ_k (x_2k − x_2k+1)²
-// over the hash's choices, which for independent samples is 4 σ²/n: d²/4 estimates the variance
-// of the pixel's mean, from exact sums (the film's sums of squares are doubles, whose rounding
-// depends on how the samples were split). A pair's two Sobol' points lie in opposite strata, so
-// for a smooth pixel d²/4 is above the true error: the rule errs towards more samples.
+// The error. The even and the odd samples of a pixel are two independent estimates of its
+// mean: two randomizations of the sampler's sequence (PathSampler::sequence_key; independent
+// numbers with the independent sampler). The film sums the odd ones again in its Half layer.
+// With n (even) samples, the two halves' means a and b differ by d = a − b, and E[d²] is twice
+// the variance of either, four times that of the pixel's mean (a + b)/2: d²/4 estimates the
+// error of the mean, the quasi-Monte Carlo gain of each randomization included (a sample
+// variance would miss it, and overstate the error of smooth pixels), and from exact sums (the
+// film's sums of squares are doubles, whose rounding depends on how the samples were split).
 // A pixel's relative error in channel c is √(d_c²/4) / max(|m_c|, 2⁻⁸), m_c its mean (below
 // 2⁻⁸ of display white the error counts as absolute); a block's error is the root mean square of
 // its pixels' over the three channels.
@@ -50,8 +51,10 @@ int next_pass_end(const NoiseRule& rule, int n);
 // Whether n samples is a pass end (or the cap).
 bool is_pass_end(const NoiseRule& rule, int n);
 
-// Whether sample s of a pixel goes into the film's Half sum: one of each pair (2k, 2k + 1).
-bool in_half(uint64_t seed, uint64_t pixel, uint64_t s);
+// Whether sample s of a pixel goes into the film's Half sum: the odd ones, one randomization.
+inline bool in_half(uint64_t s) {
+  return (s & 1) != 0;
+}
 
 // The pixels [x0, x1) × [y0, y1) of block (bx, by) of a film, cut at its edges.
 struct NoiseBlock {

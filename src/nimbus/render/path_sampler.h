@@ -58,7 +58,7 @@ class PathSampler {
   PathSampler(const RenderSettings& settings, const ZSobol& zsobol, int x, int y, uint64_t pixel,
               uint64_t sample)
       : zsobol_(settings.sampler == RenderSettings::Sampler::ZSobol ? &zsobol : nullptr),
-        key_(zsobol_ ? zsobol.key(x, y, sample) : ZSobol::Key{}),
+        key_(zsobol_ ? sequence_key(settings, zsobol, x, y, sample) : ZSobol::Key{}),
         rng_(Rng::for_sample(settings.seed, pixel, sample)) {}
 
   double get1d(uint32_t dim) {
@@ -68,6 +68,18 @@ class PathSampler {
     if (zsobol_ && dim < SampleDims::kStream) return zsobol_->get2d(key_, dim);
     const double u1 = rng_.uniform();
     return {u1, rng_.uniform()};
+  }
+
+  // Sample s's point. With a noise target, the even and the odd samples are two independent
+  // randomizations of the sequence, s taking point ⌊s/2⌋ of randomization s mod 2: the means of
+  // the two differ by the error of the pixel's mean, which render/noise_target.h estimates from
+  // them (randomized quasi-Monte Carlo's replicates).
+  static ZSobol::Key sequence_key(const RenderSettings& settings, const ZSobol& zsobol, int x,
+                                  int y, uint64_t sample) {
+    if (!(settings.noise_target > 0)) return zsobol.key(x, y, sample);
+    ZSobol::Key k = zsobol.key(x, y, sample >> 1);
+    if (sample & 1) k.seed = splitmix64(k.seed ^ 0x6a09e667f3bcc909ull);
+    return k;
   }
 
   // The path's stream, for numbers used a variable number of times.

@@ -63,7 +63,7 @@ RenderStats render_tiles(const Scene& scene, Film& film, const RenderRange& rang
       const Rgb value = to_film_rgb(L, ps.ch);
       if (!film.add(pixel, value))
         ++local.rejected_samples;
-      else if (record_half && in_half(scene.settings.seed, uint64_t(pixel), uint64_t(s)))
+      else if (record_half && in_half(uint64_t(s)))
         film.aov.half[size_t(pixel)] += to_fixed(value, film.exponent);
       if (record_first_vertex) film.aov.add(size_t(pixel), first);
     }
