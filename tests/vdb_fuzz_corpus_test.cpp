@@ -51,8 +51,8 @@ void write_corpus() {
   write_cut(kCorpus + "linear8.vdb", kCorpus + "linear8_cut_half.vdb", 0.5);
   write_cut(kCorpus + "linear8.vdb", kCorpus + "linear8_cut_90.vdb", 0.9);
   write_cut(kCorpus + "linear4.vdb", kCorpus + "linear4_cut_header.vdb", 0.1);
-  // The fuzzer's first findings, fixed in vdb_file.cpp: a grid's name longer than the file, and
-  // one without its terminating zero, which NanoVDB's header reader trusts.
+  // The fuzzer's first findings, fixed in the reader (vdb_module_openvdb.cpp): a grid's name longer
+  // than the file, and one without its terminating zero, which NanoVDB's header reader trusts.
   const std::uint64_t name_size = test::nvdb_name_size_offset();
   const std::uint64_t name = test::nvdb_name_offset();
   patch(kCorpus + "linear8.nvdb", kCorpus + "linear8_long_name.nvdb", name_size,

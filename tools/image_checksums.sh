@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Renders five scenes × three tracking modes small and prints one SHA-256 per EXR: a refactor
+# Renders seven scenes × three tracking modes small and prints one SHA-256 per EXR: a refactor
 # must change no pixel (issue 12). `--check FILE` compares with a recorded list instead and
 # exits 1 on any difference.
 #
@@ -10,7 +10,8 @@ check=${3:-}
 here="$(cd "$(dirname "$0")/.." && pwd)"
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
-scenes=(demo freeforms translucent cloud_sunlit spectral)
+# vdb_cloud and vdb_fire read their grids through the OpenVDB module (media/vdb_module.h).
+scenes=(demo freeforms translucent cloud_sunlit spectral vdb_cloud vdb_fire)
 modes=(delta spectral-history spectral-mis)
 list="$out/checksums.txt"
 for scene in "${scenes[@]}"; do

@@ -14,7 +14,7 @@ trap 'rm -rf "$work"' EXIT
 prefix="$work/prefix"
 
 cmake --install "$build" --prefix "$prefix" > "$work/install.log"
-for f in lib/libnimbus_core.a lib/cmake/nimbus/nimbusConfig.cmake \
+for f in lib/libnimbus_core.a lib/nimbus_openvdb.so lib/cmake/nimbus/nimbusConfig.cmake \
          lib/cmake/nimbus/nimbusConfigVersion.cmake lib/pkgconfig/nimbus.pc \
          include/nimbus/nimbus.h bin/nimbus share/nimbus/scenes/demo.json \
          share/nimbus/tools/plot_segments.py share/nimbus/tools/exr_to_pfm_layers.py; do
@@ -46,13 +46,18 @@ PKG_CONFIG_PATH="$prefix/lib/pkgconfig" pkg-config --cflags --libs nimbus | grep
 # The installed executable runs an experiment from the installed scenes, away from the checkout.
 (cd "$work" && "$prefix/bin/nimbus" experiment segments --quick --no-plot --out "$work/exp" > /dev/null)
 [ -s "$work/exp/segments.csv" ] || { echo "test_install: the installed nimbus ran no experiment" >&2; exit 1; }
+# It reads a VDB scene through the installed OpenVDB module (lib/nimbus_openvdb.so, issue 45).
+(cd "$work" && "$prefix/bin/nimbus" render "$prefix/share/nimbus/scenes/vdb_fire.json" --spp 1 \
+  --set film.width=16 --set film.height=12 -q -o "$work/fire.png") ||
+  { echo "test_install: the installed nimbus does not render a VDB scene" >&2; exit 1; }
 # The Python package, where the build has it: installed in Debian's layout, imported from there
 # alone, running an experiment from the installed scenes.
 python="$prefix/lib/python3/dist-packages"
 if [ -d "$build/python/nimbus" ]; then
   [ -f "$python/nimbus/__init__.py" ] || { echo "test_install: the Python package was not installed" >&2; exit 1; }
   (cd "$work" && PYTHONPATH="$python" /usr/bin/python3 -c \
-    "import nimbus; assert nimbus.__file__.startswith('$python'); nimbus.experiment('segments', quick=True)") ||
+    "import nimbus; assert nimbus.__file__.startswith('$python'); nimbus.experiment('segments', quick=True)
+nimbus.render(nimbus.load_file('$prefix/share/nimbus/scenes/vdb_fire.json', {'film.width': 8, 'film.height': 6}), spp=1)") ||
     { echo "test_install: the installed Python package does not run" >&2; exit 1; }
 fi
 echo "test_install: installed, built examples/embed outside the tree, rendered, ran an experiment"

@@ -1,8 +1,6 @@
 #include "nimbus/io/vdb_export.h"
 
 #include <fmt/format.h>
-#include <openvdb/io/File.h>
-#include <openvdb/openvdb.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -14,12 +12,17 @@
 #include <vector>
 
 #include "nimbus/io/atomic_file.h"
+#include "nimbus/media/vdb_module.h"
+#include "nimbus/os/shared_module.h"
+
+// The grid is built here as plain leaves (media/vdb_module.h); nimbus_openvdb.so, loaded before
+// the build starts, makes them an OpenVDB grid and writes it.
 
 namespace nimbus {
 namespace {
 
-using Leaf = openvdb::FloatTree::LeafNodeType;
-constexpr int kLeafDim = int(Leaf::DIM);  // 8
+using Leaf = VdbExportLeaf;
+constexpr int kLeafDim = 8;
 
 // The voxel centres i H inside [lo, hi] on one axis.
 struct AxisRange {
@@ -40,8 +43,12 @@ long long floor_div(long long a, long long b) {
   return a >= 0 ? a / b : -((-a + b - 1) / b);
 }
 
-openvdb::Vec3s to_vec3s(const Rgb& c) {
-  return openvdb::Vec3s(float(c[0]), float(c[1]), float(c[2]));
+std::array<float, 3> to_floats(const Rgb& c) {
+  return {float(c[0]), float(c[1]), float(c[2])};
+}
+
+bool is_active(const Leaf& leaf, int i) {
+  return leaf.active[i / 64] >> (i % 64) & 1;
 }
 
 }  // namespace
@@ -120,6 +127,15 @@ VdbExportResult export_vdb(const Scene& scene, int object, double h, const std::
         h, std::min({extent.x, extent.y, extent.z})));
   }
 
+  // Before the grid's build, which may take minutes: a module that cannot be loaded is one line.
+  const VdbModule* module = nullptr;
+  try {
+    module = &vdb_module();
+  } catch (const ModuleLoadError& e) {
+    throw std::invalid_argument(
+        fmt::format("writing VDB files needs nimbus's OpenVDB module: {}", e.what()));
+  }
+
   // Blocks of 8³ voxels, aligned as OpenVDB's leaves, over the voxel centres in the bounds.
   AxisRange voxel[3], block[3];
   long long blocks_along[3];
@@ -162,8 +178,8 @@ VdbExportResult export_vdb(const Scene& scene, int object, double h, const std::
       // no lookup: sparse media export in time proportional to their volume.
       const Interval F = evaluate(obj.tape, box);
       if (!(F.hi > 0) || !(density.range(box, F).hi > 0)) continue;
-      auto leaf = std::make_unique<Leaf>(
-          openvdb::Coord(int(origin[0]), int(origin[1]), int(origin[2])), 0.0f);
+      auto leaf = std::make_unique<Leaf>();
+      leaf->origin = {int(origin[0]), int(origin[1]), int(origin[2])};
       bool any = false;
       for (long long i = lo[0]; i <= hi[0]; ++i)
         for (long long j = lo[1]; j <= hi[1]; ++j)
@@ -173,7 +189,9 @@ VdbExportResult export_vdb(const Scene& scene, int object, double h, const std::
             if (!(f > 0)) continue;  // outside the object there is no medium
             const double d = medium.scale * density.value(x, f);
             if (!(d > 0)) continue;
-            leaf->setValueOn(openvdb::Coord(int(i), int(j), int(k)), static_cast<float>(d));
+            const int at = int((i - origin[0]) * 64 + (j - origin[1]) * 8 + (k - origin[2]));
+            leaf->values[at] = static_cast<float>(d);
+            leaf->active[at / 64] |= std::uint64_t(1) << (at % 64);
             any = true;
           }
       if (any) leaves[b] = std::move(leaf);
@@ -188,21 +206,31 @@ VdbExportResult export_vdb(const Scene& scene, int object, double h, const std::
 
   for (const auto& leaf : leaves)
     if (leaf)
-      for (auto v = leaf->cbeginValueOn(); v; ++v)
-        result.max_density = std::max(result.max_density, double(*v));
+      for (int i = 0; i < 512; ++i)
+        if (is_active(*leaf, i))
+          result.max_density = std::max(result.max_density, double(leaf->values[i]));
   if (!(result.max_density <= std::numeric_limits<float>::max()))
     throw std::invalid_argument(fmt::format(
         "the density reaches {}, beyond the float range of a VDB grid", result.max_density));
   // Below the threshold voxels go inactive (and 0), and leaves left without active voxels go.
   const float threshold = static_cast<float>(kVdbExportThreshold * result.max_density);
-  openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(0.0f);
+  std::vector<Leaf> kept;
   for (auto& leaf : leaves) {
     if (!leaf) continue;
-    for (auto v = leaf->beginValueOn(); v; ++v)
-      if (*v < threshold) leaf->setValueOff(v.pos(), 0.0f);
-    if (!leaf->isEmpty()) grid->tree().addLeaf(leaf.release());
+    bool any = false;
+    for (int i = 0; i < 512; ++i) {
+      if (!is_active(*leaf, i)) continue;
+      if (leaf->values[i] < threshold) {
+        leaf->values[i] = 0.0f;
+        leaf->active[i / 64] &= ~(std::uint64_t(1) << (i % 64));
+      } else {
+        ++result.active_voxels;
+        any = true;
+      }
+    }
+    if (any) kept.push_back(*leaf);
+    leaf.reset();
   }
-  result.active_voxels = grid->activeVoxelCount();
   // An empty grid would be a file that holds nothing: the voxels missed the medium.
   if (result.active_voxels == 0)
     throw std::invalid_argument(fmt::format(
@@ -210,19 +238,17 @@ VdbExportResult export_vdb(const Scene& scene, int object, double h, const std::
         "a smaller voxel size",
         h, voxels));
 
-  openvdb::initialize();
-  grid->setName("density");
-  grid->setGridClass(openvdb::GRID_FOG_VOLUME);
-  grid->setTransform(openvdb::math::Transform::createLinearTransform(h));
-  grid->insertMeta("sigma_a", openvdb::Vec3SMetadata(to_vec3s(medium.sigma_a.rgb)));
-  grid->insertMeta("sigma_s", openvdb::Vec3SMetadata(to_vec3s(medium.sigma_s.rgb)));
-  grid->insertMeta("phase_g", openvdb::FloatMetadata(float(medium.g)));
-  openvdb::MetaMap file_meta;
-  file_meta.insertMeta("creator", openvdb::StringMetadata("nimbus " NIMBUS_VERSION));
+  VdbWriteRequest request;
+  request.leaves = &kept;
+  request.voxel_size = h;
+  request.sigma_a = to_floats(medium.sigma_a.rgb);
+  request.sigma_s = to_floats(medium.sigma_s.rgb);
+  request.phase_g = float(medium.g);
+  request.creator = "nimbus " NIMBUS_VERSION;
   write_atomically(path, [&](const std::string& temp) {
-    openvdb::io::File file(temp);
-    file.write({grid}, file_meta);
-    file.close();
+    request.path = temp;
+    if (const std::string problem = module->write(request); !problem.empty())
+      throw std::runtime_error(problem);
   });
   return result;
 }
