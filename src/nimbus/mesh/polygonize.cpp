@@ -474,12 +474,12 @@ const std::array<Vec3, 13>& fixed_directions() {
   return directions;
 }
 
-// A point's distance to the surface, tighter than surface_distance where that is above `bound`:
-// the least root along 13 more fixed directions (axes, face and cube diagonals). Along a face's
-// normal, a point on a sharp edge's chamfer may see the far side of the shape first, which
-// would refine the whole grid for an error that is not there.
-double tight_distance(const Tape& tape, const Vec3& p, const Vec3& n, double reach, double bound) {
-  double d = surface_distance(tape, p, n, reach);
+// d, a point's distance to the surface along some line, or where that is above `bound`, the
+// distance to a root within `bound` along one of 13 more fixed directions (axes, face and cube
+// diagonals), if there is one. Along a face's normal, a point on a sharp edge's chamfer may see
+// the far side of the shape first, which would refine the whole grid for an error that is not
+// there.
+double fixed_direction_distance(const Tape& tape, const Vec3& p, double d, double bound) {
   // Only whether a root lies within the bound matters: each direction is searched that far (a
   // short search, where interval root finding costs most), and the first one found ends it.
   for (const Vec3& w : fixed_directions()) {
@@ -489,27 +489,104 @@ double tight_distance(const Tape& tape, const Vec3& p, const Vec3& n, double rea
   return d;
 }
 
+// A point's distance to the surface, tighter than surface_distance where that is above `bound`.
+double tight_distance(const Tape& tape, const Vec3& p, const Vec3& n, double reach, double bound) {
+  return fixed_direction_distance(tape, p, surface_distance(tape, p, n, reach), bound);
+}
+
+// A face's sample points, its centroid and edge midpoints, and its unit normal; false for a
+// degenerate face, whose distance counts as 0.
+bool face_samples(const TriangleMesh& mesh, const std::array<std::uint32_t, 3>& t,
+                  std::array<Vec3, 4>& points, Vec3& u) {
+  const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]];
+  const Vec3 n = cross(b - a, c - a);
+  if (!(length(n) > 0)) return false;
+  u = normalize(n);
+  points = {(a + b + c) / 3.0, (a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5};
+  return true;
+}
+
 // The largest distance of a face's centroid or edge midpoints to the surface.
 double face_distance(const Tape& tape, const TriangleMesh& mesh,
                      const std::array<std::uint32_t, 3>& t, double reach, double bound) {
-  const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]];
-  const Vec3 n = cross(b - a, c - a);
-  if (!(length(n) > 0)) return 0;
-  const Vec3 u = normalize(n);
+  std::array<Vec3, 4> points;
+  Vec3 u;
+  if (!face_samples(mesh, t, points, u)) return 0;
   double worst = 0;
-  for (const Vec3& p : {(a + b + c) / 3.0, (a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5})
-    worst = std::max(worst, tight_distance(tape, p, u, reach, bound));
+  for (const Vec3& p : points) worst = std::max(worst, tight_distance(tape, p, u, reach, bound));
   return worst;
 }
 
-// Each face's face_distance.
-std::vector<double> face_distances(const Tape& tape, const TriangleMesh& mesh, double reach,
-                                   double bound) {
-  std::vector<double> d(mesh.triangles.size(), 0);
-  tbb::parallel_for(std::size_t{0}, mesh.triangles.size(), [&](std::size_t i) {
-    d[i] = face_distance(tape, mesh, mesh.triangles[i], reach, bound);
+// A grid's faces measured as far as polygonize's choice needs: the largest face_distance, and
+// whether at most one face in kFewFailing fails (then each face's face_distance, for bisection).
+// Every sample point is first measured along its face's normal; the 13 fixed directions, which
+// cost 26 root searches where no root within the bound is found, are then searched at the points
+// above the bound, farthest first, in batches, only until that choice is made: the farthest
+// point they leave above the bound is the largest distance, and once more than one face in
+// kFewFailing is known to fail the rest cannot change the choice. A coarse grid whose faces
+// mostly fail is searched at about one face in 20, not at every point. The same result for any
+// number of threads.
+struct FaceMeasure {
+  std::vector<double> distance;  // each face's face_distance where `exact`
+  double worst = 0;              // the largest face_distance
+  bool exact = true;             // false: more than one face in kFewFailing fails
+};
+FaceMeasure measure_faces(const Tape& tape, const TriangleMesh& mesh, double reach, double bound) {
+  const std::size_t faces = mesh.triangles.size();
+  std::vector<std::array<double, 4>> along(faces);
+  tbb::parallel_for(std::size_t{0}, faces, [&](std::size_t i) {
+    std::array<Vec3, 4> points;
+    Vec3 u;
+    along[i] = {0, 0, 0, 0};
+    if (face_samples(mesh, mesh.triangles[i], points, u))
+      for (std::size_t k = 0; k < 4; ++k) along[i][k] = surface_distance(tape, points[k], u, reach);
   });
-  return d;
+  // The points above the bound (4 face + k), farthest first.
+  std::vector<std::pair<double, std::size_t>> above;
+  for (std::size_t i = 0; i < faces; ++i)
+    for (std::size_t k = 0; k < 4; ++k)
+      if (along[i][k] > bound) above.push_back({along[i][k], 4 * i + k});
+  std::sort(above.begin(), above.end(), [](const auto& x, const auto& y) {
+    return x.first > y.first || (x.first == y.first && x.second < y.second);
+  });
+  FaceMeasure out;
+  std::vector<char> failing(faces, 0);
+  std::size_t failing_faces = 0;
+  bool worst_known = false;
+  // Enough points for both threads, few past the choice.
+  constexpr std::size_t kBatch = 256;
+  std::vector<double> searched;
+  for (std::size_t next = 0; next < above.size(); next += kBatch) {
+    if (worst_known && failing_faces * kFewFailing > faces) {
+      out.exact = false;
+      break;
+    }
+    const std::size_t count = std::min(kBatch, above.size() - next);
+    searched.resize(count);
+    tbb::parallel_for(std::size_t{0}, count, [&](std::size_t j) {
+      const std::size_t i = above[next + j].second / 4, k = above[next + j].second % 4;
+      std::array<Vec3, 4> points;
+      Vec3 u;
+      face_samples(mesh, mesh.triangles[i], points, u);
+      searched[j] = fixed_direction_distance(tape, points[k], above[next + j].first, bound);
+    });
+    for (std::size_t j = 0; j < count; ++j) {
+      const std::size_t i = above[next + j].second / 4, k = above[next + j].second % 4;
+      along[i][k] = searched[j];
+      if (searched[j] <= bound) continue;
+      if (!worst_known) out.worst = searched[j];
+      worst_known = true;
+      if (!failing[i]) ++failing_faces;
+      failing[i] = 1;
+    }
+  }
+  if (!out.exact) return out;
+  out.distance.resize(faces);
+  for (std::size_t i = 0; i < faces; ++i) {
+    out.distance[i] = *std::max_element(along[i].begin(), along[i].end());
+    out.worst = std::max(out.worst, out.distance[i]);
+  }
+  return out;
 }
 
 // The point of the surface nearest p among the roots along n, the gradient and 13 fixed
@@ -676,8 +753,9 @@ TriangleMesh polygonize(const Tape& tape, const PolygonizeOptions& options,
     r.cell = h;
     r.cells = gm.cells;
     r.vertex_error = gm.vertex_error;
-    const std::vector<double> distance = face_distances(tape, gm.mesh, 2 * h, options.error);
-    r.face_error = distance.empty() ? 0 : *std::max_element(distance.begin(), distance.end());
+    const FaceMeasure measured = measure_faces(tape, gm.mesh, 2 * h, options.error);
+    const std::vector<double>& distance = measured.distance;
+    r.face_error = measured.worst;
     previous_cells = std::max<std::uint64_t>(gm.cells, 1);
     if (!gm.hidden && !gm.mesh.triangles.empty()) {
       if (r.face_error <= options.error) {
@@ -688,7 +766,7 @@ TriangleMesh polygonize(const Tape& tape, const PolygonizeOptions& options,
       // memory budget), else the grid is refined.
       const auto failing = std::size_t(std::count_if(distance.begin(), distance.end(),
                                                      [&](double d) { return d > options.error; }));
-      if (failing * kFewFailing <= distance.size()) {
+      if (measured.exact && failing * kFewFailing <= distance.size()) {
         TriangleMesh bisected = gm.mesh;
         // Two faces a surface cell: the memory budget's count (kPolygonizeBytesPerCell).
         const std::size_t budget =
