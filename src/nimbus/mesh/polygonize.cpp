@@ -506,14 +506,18 @@ bool face_samples(const TriangleMesh& mesh, const std::array<std::uint32_t, 3>& 
   return true;
 }
 
-// The largest distance of a face's centroid or edge midpoints to the surface.
+// The largest distance of a face's centroid or edge midpoints to the surface, or, once one is
+// above `bound`, that one's: the face fails, and by how much no longer matters.
 double face_distance(const Tape& tape, const TriangleMesh& mesh,
                      const std::array<std::uint32_t, 3>& t, double reach, double bound) {
   std::array<Vec3, 4> points;
   Vec3 u;
   if (!face_samples(mesh, t, points, u)) return 0;
   double worst = 0;
-  for (const Vec3& p : points) worst = std::max(worst, tight_distance(tape, p, u, reach, bound));
+  for (const Vec3& p : points) {
+    worst = std::max(worst, tight_distance(tape, p, u, reach, bound));
+    if (worst > bound) break;
+  }
   return worst;
 }
 
@@ -614,8 +618,9 @@ std::optional<Vec3> nearest_surface_point(const Tape& tape, const Vec3& p, const
 // moved onto the surface, in both faces that share it, so that the mesh stays closed and
 // 2-manifold, until every face is within the bound. Sequential, in the faces' order: the same
 // mesh for any number of threads. `distance` holds each face's face_distance, and is kept so for
-// the faces the bisection adds and changes. False, with the mesh half done, where a midpoint finds
-// no surface within reach or the faces pass max_faces.
+// the faces the bisection adds and changes (a face is measured again only once it has changed).
+// False, with the mesh half done, where a midpoint finds no surface within reach or the faces
+// pass max_faces.
 bool bisect_failing_faces(const Tape& tape, TriangleMesh& m, std::vector<double>& distance,
                           double error, double reach, std::size_t max_faces) {
   using Face = std::array<std::uint32_t, 3>;
@@ -640,10 +645,13 @@ bool bisect_failing_faces(const Tape& tape, TriangleMesh& m, std::vector<double>
   std::deque<std::uint32_t> failing;
   for (std::uint32_t i = 0; i < m.triangles.size(); ++i)
     if (distance[i] > error) failing.push_back(i);
+  // Whether distance[i] is that of face i as it is now.
+  std::vector<char> measured(m.triangles.size(), 1);
   while (!failing.empty()) {
     const std::uint32_t t = failing.front();
     failing.pop_front();
-    distance[t] = face_distance(tape, m, m.triangles[t], reach, error);
+    if (!measured[t]) distance[t] = face_distance(tape, m, m.triangles[t], reach, error);
+    measured[t] = 1;
     if (distance[t] <= error) continue;
     if (m.triangles.size() + 2 > max_faces) return false;
     // The longest edge, as (a, b) in the face's order, and c the third vertex.
@@ -678,6 +686,8 @@ bool bisect_failing_faces(const Tape& tape, TriangleMesh& m, std::vector<double>
     m.triangles.push_back({v, a, d});
     // Each changed face is measured again when it is taken from the queue.
     distance.resize(m.triangles.size(), std::numeric_limits<double>::infinity());
+    measured.resize(m.triangles.size(), 0);
+    measured[t] = measured[u] = 0;
     faces_of.erase(key(a, b));
     replace(b, c, t, t1);
     replace(a, d, u, u1);
