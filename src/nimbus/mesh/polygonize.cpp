@@ -29,6 +29,11 @@ constexpr double kGridShift = 0.3819660112501051;
 // ε = 0.004 fails at 7 % of its first grid's faces, bisected to 2 052 faces where the refined grid
 // had 3 860; a ring at 0.002, 7 556 where refining gave 35 904 (docs/meshes.md).
 constexpr std::size_t kFewFailing = 4;
+// A face's sample point where F changes sign within this fraction of the error bound along the
+// face's normal is that near the surface: two or three values of F show it, where measuring it
+// takes two exact root searches. Such a point fails nothing, and the largest distance, which the
+// report and the next grid need, is measured exactly wherever it is below this (exact_largest).
+constexpr double kSignProbe = 0.5;
 // A refined grid aims its cell at this fraction of the error bound (the faces' error falling as
 // the square of the cell), leaving room for the prediction's miss.
 constexpr double kAimedError = 0.7;
@@ -492,9 +497,24 @@ double fixed_direction_distance(const Tape& tape, const Vec3& p, double d, doubl
   return d;
 }
 
-// A point's distance to the surface, tighter than surface_distance where that is above `bound`.
-double tight_distance(const Tape& tape, const Vec3& p, const Vec3& n, double reach, double bound) {
-  return fixed_direction_distance(tape, p, surface_distance(tape, p, n, reach), bound);
+// Whether F changes sign between p and p + s u or p − s u: the nearest root along u lies within s.
+bool sign_change_within(const Tape& tape, const Vec3& p, const Vec3& u, double s) {
+  const bool inside = evaluate(tape, p) > 0;
+  return (evaluate(tape, p + u * s) > 0) != inside || (evaluate(tape, p - u * s) > 0) != inside;
+}
+
+// A sample point's distance to the surface along its face's normal u (surface_distance), or
+// `near`, an upper bound, where F changes sign within `near` of it along u (0: always measured).
+double probed_distance(const Tape& tape, const Vec3& p, const Vec3& u, double reach, double near) {
+  if (near > 0 && sign_change_within(tape, p, u, near)) return near;
+  return surface_distance(tape, p, u, reach);
+}
+
+// A point's distance to the surface (probed_distance), tighter than surface_distance where that
+// is above `bound`.
+double tight_distance(const Tape& tape, const Vec3& p, const Vec3& n, double reach, double bound,
+                      double near) {
+  return fixed_direction_distance(tape, p, probed_distance(tape, p, n, reach, near), bound);
 }
 
 // A face's sample points, its centroid and edge midpoints, and its unit normal; false for a
@@ -509,24 +529,42 @@ bool face_samples(const TriangleMesh& mesh, const std::array<std::uint32_t, 3>& 
   return true;
 }
 
-// The largest distance of a face's centroid or edge midpoints to the surface, or, once one is
-// above `bound`, that one's: the face fails, and by how much no longer matters.
+// The largest distance of a face's centroid or edge midpoints to the surface (tight_distance:
+// `near` where probing shows no more), or, once one is above `bound`, that one's: the face fails,
+// and by how much no longer matters.
 double face_distance(const Tape& tape, const TriangleMesh& mesh,
-                     const std::array<std::uint32_t, 3>& t, double reach, double bound) {
+                     const std::array<std::uint32_t, 3>& t, double reach, double bound,
+                     double near) {
   std::array<Vec3, 4> points;
   Vec3 u;
   if (!face_samples(mesh, t, points, u)) return 0;
   double worst = 0;
   for (const Vec3& p : points) {
-    worst = std::max(worst, tight_distance(tape, p, u, reach, bound));
+    worst = std::max(worst, tight_distance(tape, p, u, reach, bound, near));
     if (worst > bound) break;
   }
   return worst;
 }
 
+// The largest face distance, exact: a face at `near` may be nearer (probed_distance), and where
+// that is the largest, those faces are measured.
+double exact_largest(const Tape& tape, const TriangleMesh& mesh, std::vector<double>& distance,
+                     double reach, double bound, double near) {
+  const auto largest = [&] {
+    return distance.empty() ? 0.0 : *std::max_element(distance.begin(), distance.end());
+  };
+  if (largest() != near) return largest();
+  tbb::parallel_for(std::size_t{0}, distance.size(), [&](std::size_t i) {
+    if (distance[i] == near)
+      distance[i] = face_distance(tape, mesh, mesh.triangles[i], reach, bound, 0);
+  });
+  return largest();
+}
+
 // A grid's faces measured as far as polygonize's choice needs: the largest face_distance, and
 // whether at most one face in kFewFailing fails (then each face's face_distance, for bisection).
-// Every sample point is first measured along its face's normal; the 13 fixed directions, which
+// Every sample point is first measured along its face's normal (probed_distance: `near` where a
+// sign change shows it that near); the 13 fixed directions, which
 // cost 26 root searches where no root within the bound is found, are then searched at the points
 // above the bound, farthest first, in batches, only until that choice is made: the farthest
 // point they leave above the bound is the largest distance, and once more than one face in
@@ -538,7 +576,8 @@ struct FaceMeasure {
   double worst = 0;              // the largest face_distance
   bool exact = true;             // false: more than one face in kFewFailing fails
 };
-FaceMeasure measure_faces(const Tape& tape, const TriangleMesh& mesh, double reach, double bound) {
+FaceMeasure measure_faces(const Tape& tape, const TriangleMesh& mesh, double reach, double bound,
+                          double near) {
   const std::size_t faces = mesh.triangles.size();
   std::vector<std::array<double, 4>> along(faces);
   tbb::parallel_for(std::size_t{0}, faces, [&](std::size_t i) {
@@ -546,7 +585,8 @@ FaceMeasure measure_faces(const Tape& tape, const TriangleMesh& mesh, double rea
     Vec3 u;
     along[i] = {0, 0, 0, 0};
     if (face_samples(mesh, mesh.triangles[i], points, u))
-      for (std::size_t k = 0; k < 4; ++k) along[i][k] = surface_distance(tape, points[k], u, reach);
+      for (std::size_t k = 0; k < 4; ++k)
+        along[i][k] = probed_distance(tape, points[k], u, reach, near);
   });
   // The points above the bound (4 face + k), farthest first.
   std::vector<std::pair<double, std::size_t>> above;
@@ -589,10 +629,9 @@ FaceMeasure measure_faces(const Tape& tape, const TriangleMesh& mesh, double rea
   }
   if (!out.exact) return out;
   out.distance.resize(faces);
-  for (std::size_t i = 0; i < faces; ++i) {
+  for (std::size_t i = 0; i < faces; ++i)
     out.distance[i] = *std::max_element(along[i].begin(), along[i].end());
-    out.worst = std::max(out.worst, out.distance[i]);
-  }
+  out.worst = exact_largest(tape, mesh, out.distance, reach, bound, near);
   return out;
 }
 
@@ -625,7 +664,7 @@ std::optional<Vec3> nearest_surface_point(const Tape& tape, const Vec3& p, const
 // False, with the mesh half done, where a midpoint finds no surface within reach or the faces
 // pass max_faces.
 bool bisect_failing_faces(const Tape& tape, TriangleMesh& m, std::vector<double>& distance,
-                          double error, double reach, std::size_t max_faces) {
+                          double error, double near, double reach, std::size_t max_faces) {
   using Face = std::array<std::uint32_t, 3>;
   constexpr std::uint32_t kNone = ~std::uint32_t{0};
   const auto key = [](std::uint32_t a, std::uint32_t b) {
@@ -653,7 +692,7 @@ bool bisect_failing_faces(const Tape& tape, TriangleMesh& m, std::vector<double>
   while (!failing.empty()) {
     const std::uint32_t t = failing.front();
     failing.pop_front();
-    if (!measured[t]) distance[t] = face_distance(tape, m, m.triangles[t], reach, error);
+    if (!measured[t]) distance[t] = face_distance(tape, m, m.triangles[t], reach, error, near);
     measured[t] = 1;
     if (distance[t] <= error) continue;
     if (m.triangles.size() + 2 > max_faces) return false;
@@ -766,7 +805,8 @@ TriangleMesh polygonize(const Tape& tape, const PolygonizeOptions& options,
     r.cell = h;
     r.cells = gm.cells;
     r.vertex_error = gm.vertex_error;
-    const FaceMeasure measured = measure_faces(tape, gm.mesh, 2 * h, options.error);
+    const double near = kSignProbe * options.error;
+    const FaceMeasure measured = measure_faces(tape, gm.mesh, 2 * h, options.error, near);
     const std::vector<double>& distance = measured.distance;
     r.face_error = measured.worst;
     previous_cells = std::max<std::uint64_t>(gm.cells, 1);
@@ -785,9 +825,10 @@ TriangleMesh polygonize(const Tape& tape, const PolygonizeOptions& options,
         const std::size_t budget =
             options.max_cells > 0 ? std::size_t(2 * options.max_cells) : ~std::size_t{0};
         std::vector<double> bisected_distance = distance;
-        if (bisect_failing_faces(tape, bisected, bisected_distance, options.error, 2 * h,
+        if (bisect_failing_faces(tape, bisected, bisected_distance, options.error, near, 2 * h,
                                  std::min(4 * gm.mesh.triangles.size(), budget))) {
-          r.face_error = *std::max_element(bisected_distance.begin(), bisected_distance.end());
+          r.face_error =
+              exact_largest(tape, bisected, bisected_distance, 2 * h, options.error, near);
           r.bisected = bisected.triangles.size() - gm.mesh.triangles.size();
           if (report) *report = r;
           return bisected;
