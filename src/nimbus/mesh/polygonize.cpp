@@ -24,8 +24,16 @@ namespace {
 // cells, (3 − √5) / 2.
 constexpr double kGridShift = 0.3819660112501051;
 // A grid whose failing faces are at most one in this many has them bisected (bisect_failing_faces)
-// rather than the whole grid refined.
-constexpr std::size_t kFewFailing = 20;
+// rather than the whole grid refined. Bisecting a quarter of a grid's faces adds fewer faces than
+// the refined grid would have, and takes less time: the free form of four perturbations at
+// ε = 0.004 fails at 7 % of its first grid's faces, bisected to 2 052 faces where the refined grid
+// had 3 860; a ring at 0.002, 7 556 where refining gave 35 904 (docs/meshes.md).
+constexpr std::size_t kFewFailing = 4;
+// A face's sample point where F changes sign within this fraction of the error bound along the
+// face's normal is that near the surface: two or three values of F show it, where measuring it
+// takes two exact root searches. Such a point fails nothing, and the largest distance, which the
+// report and the next grid need, is measured exactly wherever it is below this (exact_largest).
+constexpr double kSignProbe = 0.5;
 // A refined grid aims its cell at this fraction of the error bound (the faces' error falling as
 // the square of the cell), leaving room for the prediction's miss.
 constexpr double kAimedError = 0.7;
@@ -474,12 +482,12 @@ const std::array<Vec3, 13>& fixed_directions() {
   return directions;
 }
 
-// A point's distance to the surface, tighter than surface_distance where that is above `bound`:
-// the least root along 13 more fixed directions (axes, face and cube diagonals). Along a face's
-// normal, a point on a sharp edge's chamfer may see the far side of the shape first, which
-// would refine the whole grid for an error that is not there.
-double tight_distance(const Tape& tape, const Vec3& p, const Vec3& n, double reach, double bound) {
-  double d = surface_distance(tape, p, n, reach);
+// d, a point's distance to the surface along some line, or where that is above `bound`, the
+// distance to a root within `bound` along one of 13 more fixed directions (axes, face and cube
+// diagonals), if there is one. Along a face's normal, a point on a sharp edge's chamfer may see
+// the far side of the shape first, which would refine the whole grid for an error that is not
+// there.
+double fixed_direction_distance(const Tape& tape, const Vec3& p, double d, double bound) {
   // Only whether a root lies within the bound matters: each direction is searched that far (a
   // short search, where interval root finding costs most), and the first one found ends it.
   for (const Vec3& w : fixed_directions()) {
@@ -489,27 +497,142 @@ double tight_distance(const Tape& tape, const Vec3& p, const Vec3& n, double rea
   return d;
 }
 
-// The largest distance of a face's centroid or edge midpoints to the surface.
-double face_distance(const Tape& tape, const TriangleMesh& mesh,
-                     const std::array<std::uint32_t, 3>& t, double reach, double bound) {
+// Whether F changes sign between p and p + s u or p − s u: the nearest root along u lies within s.
+bool sign_change_within(const Tape& tape, const Vec3& p, const Vec3& u, double s) {
+  const bool inside = evaluate(tape, p) > 0;
+  return (evaluate(tape, p + u * s) > 0) != inside || (evaluate(tape, p - u * s) > 0) != inside;
+}
+
+// A sample point's distance to the surface along its face's normal u (surface_distance), or
+// `near`, an upper bound, where F changes sign within `near` of it along u (0: always measured).
+double probed_distance(const Tape& tape, const Vec3& p, const Vec3& u, double reach, double near) {
+  if (near > 0 && sign_change_within(tape, p, u, near)) return near;
+  return surface_distance(tape, p, u, reach);
+}
+
+// A point's distance to the surface (probed_distance), tighter than surface_distance where that
+// is above `bound`.
+double tight_distance(const Tape& tape, const Vec3& p, const Vec3& n, double reach, double bound,
+                      double near) {
+  return fixed_direction_distance(tape, p, probed_distance(tape, p, n, reach, near), bound);
+}
+
+// A face's sample points, its centroid and edge midpoints, and its unit normal; false for a
+// degenerate face, whose distance counts as 0.
+bool face_samples(const TriangleMesh& mesh, const std::array<std::uint32_t, 3>& t,
+                  std::array<Vec3, 4>& points, Vec3& u) {
   const Vec3 &a = mesh.positions[t[0]], &b = mesh.positions[t[1]], &c = mesh.positions[t[2]];
   const Vec3 n = cross(b - a, c - a);
-  if (!(length(n) > 0)) return 0;
-  const Vec3 u = normalize(n);
+  if (!(length(n) > 0)) return false;
+  u = normalize(n);
+  points = {(a + b + c) / 3.0, (a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5};
+  return true;
+}
+
+// The largest distance of a face's centroid or edge midpoints to the surface (tight_distance:
+// `near` where probing shows no more), or, once one is above `bound`, that one's: the face fails,
+// and by how much no longer matters.
+double face_distance(const Tape& tape, const TriangleMesh& mesh,
+                     const std::array<std::uint32_t, 3>& t, double reach, double bound,
+                     double near) {
+  std::array<Vec3, 4> points;
+  Vec3 u;
+  if (!face_samples(mesh, t, points, u)) return 0;
   double worst = 0;
-  for (const Vec3& p : {(a + b + c) / 3.0, (a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5})
-    worst = std::max(worst, tight_distance(tape, p, u, reach, bound));
+  for (const Vec3& p : points) {
+    worst = std::max(worst, tight_distance(tape, p, u, reach, bound, near));
+    if (worst > bound) break;
+  }
   return worst;
 }
 
-// Each face's face_distance.
-std::vector<double> face_distances(const Tape& tape, const TriangleMesh& mesh, double reach,
-                                   double bound) {
-  std::vector<double> d(mesh.triangles.size(), 0);
-  tbb::parallel_for(std::size_t{0}, mesh.triangles.size(), [&](std::size_t i) {
-    d[i] = face_distance(tape, mesh, mesh.triangles[i], reach, bound);
+// The largest face distance, exact: a face at `near` may be nearer (probed_distance), and where
+// that is the largest, those faces are measured.
+double exact_largest(const Tape& tape, const TriangleMesh& mesh, std::vector<double>& distance,
+                     double reach, double bound, double near) {
+  const auto largest = [&] {
+    return distance.empty() ? 0.0 : *std::max_element(distance.begin(), distance.end());
+  };
+  if (largest() != near) return largest();
+  tbb::parallel_for(std::size_t{0}, distance.size(), [&](std::size_t i) {
+    if (distance[i] == near)
+      distance[i] = face_distance(tape, mesh, mesh.triangles[i], reach, bound, 0);
   });
-  return d;
+  return largest();
+}
+
+// A grid's faces measured as far as polygonize's choice needs: the largest face_distance, and
+// whether at most one face in kFewFailing fails (then each face's face_distance, for bisection).
+// Every sample point is first measured along its face's normal (probed_distance: `near` where a
+// sign change shows it that near); the 13 fixed directions, which
+// cost 26 root searches where no root within the bound is found, are then searched at the points
+// above the bound, farthest first, in batches, only until that choice is made: the farthest
+// point they leave above the bound is the largest distance, and once more than one face in
+// kFewFailing is known to fail the rest cannot change the choice. A coarse grid whose faces
+// mostly fail is searched at about one face in kFewFailing, not at every point. The same result
+// for any number of threads.
+struct FaceMeasure {
+  std::vector<double> distance;  // each face's face_distance where `exact`
+  double worst = 0;              // the largest face_distance
+  bool exact = true;             // false: more than one face in kFewFailing fails
+};
+FaceMeasure measure_faces(const Tape& tape, const TriangleMesh& mesh, double reach, double bound,
+                          double near) {
+  const std::size_t faces = mesh.triangles.size();
+  std::vector<std::array<double, 4>> along(faces);
+  tbb::parallel_for(std::size_t{0}, faces, [&](std::size_t i) {
+    std::array<Vec3, 4> points;
+    Vec3 u;
+    along[i] = {0, 0, 0, 0};
+    if (face_samples(mesh, mesh.triangles[i], points, u))
+      for (std::size_t k = 0; k < 4; ++k)
+        along[i][k] = probed_distance(tape, points[k], u, reach, near);
+  });
+  // The points above the bound (4 face + k), farthest first.
+  std::vector<std::pair<double, std::size_t>> above;
+  for (std::size_t i = 0; i < faces; ++i)
+    for (std::size_t k = 0; k < 4; ++k)
+      if (along[i][k] > bound) above.push_back({along[i][k], 4 * i + k});
+  std::sort(above.begin(), above.end(), [](const auto& x, const auto& y) {
+    return x.first > y.first || (x.first == y.first && x.second < y.second);
+  });
+  FaceMeasure out;
+  std::vector<char> failing(faces, 0);
+  std::size_t failing_faces = 0;
+  bool worst_known = false;
+  // Enough points for both threads, few past the choice.
+  constexpr std::size_t kBatch = 256;
+  std::vector<double> searched;
+  for (std::size_t next = 0; next < above.size(); next += kBatch) {
+    if (worst_known && failing_faces * kFewFailing > faces) {
+      out.exact = false;
+      break;
+    }
+    const std::size_t count = std::min(kBatch, above.size() - next);
+    searched.resize(count);
+    tbb::parallel_for(std::size_t{0}, count, [&](std::size_t j) {
+      const std::size_t i = above[next + j].second / 4, k = above[next + j].second % 4;
+      std::array<Vec3, 4> points;
+      Vec3 u;
+      face_samples(mesh, mesh.triangles[i], points, u);
+      searched[j] = fixed_direction_distance(tape, points[k], above[next + j].first, bound);
+    });
+    for (std::size_t j = 0; j < count; ++j) {
+      const std::size_t i = above[next + j].second / 4, k = above[next + j].second % 4;
+      along[i][k] = searched[j];
+      if (searched[j] <= bound) continue;
+      if (!worst_known) out.worst = searched[j];
+      worst_known = true;
+      if (!failing[i]) ++failing_faces;
+      failing[i] = 1;
+    }
+  }
+  if (!out.exact) return out;
+  out.distance.resize(faces);
+  for (std::size_t i = 0; i < faces; ++i)
+    out.distance[i] = *std::max_element(along[i].begin(), along[i].end());
+  out.worst = exact_largest(tape, mesh, out.distance, reach, bound, near);
+  return out;
 }
 
 // The point of the surface nearest p among the roots along n, the gradient and 13 fixed
@@ -537,10 +660,11 @@ std::optional<Vec3> nearest_surface_point(const Tape& tape, const Vec3& p, const
 // moved onto the surface, in both faces that share it, so that the mesh stays closed and
 // 2-manifold, until every face is within the bound. Sequential, in the faces' order: the same
 // mesh for any number of threads. `distance` holds each face's face_distance, and is kept so for
-// the faces the bisection adds and changes. False, with the mesh half done, where a midpoint finds
-// no surface within reach or the faces pass max_faces.
+// the faces the bisection adds and changes (a face is measured again only once it has changed).
+// False, with the mesh half done, where a midpoint finds no surface within reach or the faces
+// pass max_faces.
 bool bisect_failing_faces(const Tape& tape, TriangleMesh& m, std::vector<double>& distance,
-                          double error, double reach, std::size_t max_faces) {
+                          double error, double near, double reach, std::size_t max_faces) {
   using Face = std::array<std::uint32_t, 3>;
   constexpr std::uint32_t kNone = ~std::uint32_t{0};
   const auto key = [](std::uint32_t a, std::uint32_t b) {
@@ -563,10 +687,13 @@ bool bisect_failing_faces(const Tape& tape, TriangleMesh& m, std::vector<double>
   std::deque<std::uint32_t> failing;
   for (std::uint32_t i = 0; i < m.triangles.size(); ++i)
     if (distance[i] > error) failing.push_back(i);
+  // Whether distance[i] is that of face i as it is now.
+  std::vector<char> measured(m.triangles.size(), 1);
   while (!failing.empty()) {
     const std::uint32_t t = failing.front();
     failing.pop_front();
-    distance[t] = face_distance(tape, m, m.triangles[t], reach, error);
+    if (!measured[t]) distance[t] = face_distance(tape, m, m.triangles[t], reach, error, near);
+    measured[t] = 1;
     if (distance[t] <= error) continue;
     if (m.triangles.size() + 2 > max_faces) return false;
     // The longest edge, as (a, b) in the face's order, and c the third vertex.
@@ -601,6 +728,8 @@ bool bisect_failing_faces(const Tape& tape, TriangleMesh& m, std::vector<double>
     m.triangles.push_back({v, a, d});
     // Each changed face is measured again when it is taken from the queue.
     distance.resize(m.triangles.size(), std::numeric_limits<double>::infinity());
+    measured.resize(m.triangles.size(), 0);
+    measured[t] = measured[u] = 0;
     faces_of.erase(key(a, b));
     replace(b, c, t, t1);
     replace(a, d, u, u1);
@@ -676,8 +805,10 @@ TriangleMesh polygonize(const Tape& tape, const PolygonizeOptions& options,
     r.cell = h;
     r.cells = gm.cells;
     r.vertex_error = gm.vertex_error;
-    const std::vector<double> distance = face_distances(tape, gm.mesh, 2 * h, options.error);
-    r.face_error = distance.empty() ? 0 : *std::max_element(distance.begin(), distance.end());
+    const double near = kSignProbe * options.error;
+    const FaceMeasure measured = measure_faces(tape, gm.mesh, 2 * h, options.error, near);
+    const std::vector<double>& distance = measured.distance;
+    r.face_error = measured.worst;
     previous_cells = std::max<std::uint64_t>(gm.cells, 1);
     if (!gm.hidden && !gm.mesh.triangles.empty()) {
       if (r.face_error <= options.error) {
@@ -688,15 +819,16 @@ TriangleMesh polygonize(const Tape& tape, const PolygonizeOptions& options,
       // memory budget), else the grid is refined.
       const auto failing = std::size_t(std::count_if(distance.begin(), distance.end(),
                                                      [&](double d) { return d > options.error; }));
-      if (failing * kFewFailing <= distance.size()) {
+      if (measured.exact && failing * kFewFailing <= distance.size()) {
         TriangleMesh bisected = gm.mesh;
         // Two faces a surface cell: the memory budget's count (kPolygonizeBytesPerCell).
         const std::size_t budget =
             options.max_cells > 0 ? std::size_t(2 * options.max_cells) : ~std::size_t{0};
         std::vector<double> bisected_distance = distance;
-        if (bisect_failing_faces(tape, bisected, bisected_distance, options.error, 2 * h,
+        if (bisect_failing_faces(tape, bisected, bisected_distance, options.error, near, 2 * h,
                                  std::min(4 * gm.mesh.triangles.size(), budget))) {
-          r.face_error = *std::max_element(bisected_distance.begin(), bisected_distance.end());
+          r.face_error =
+              exact_largest(tape, bisected, bisected_distance, 2 * h, options.error, near);
           r.bisected = bisected.triangles.size() - gm.mesh.triangles.size();
           if (report) *report = r;
           return bisected;
