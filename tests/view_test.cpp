@@ -124,6 +124,25 @@ TEST_F(Session, TheFilmsImageHasTheScenesAovLayers) {
   EXPECT_EQ(f.film_image->rgb, expected.rgb);
 }
 
+// To a noise target the session refines until every block is done, then stops: the image is
+// render()'s to the bit, most pixels short of the cap, and the frame says all pixels are done.
+TEST_F(Session, ToANoiseTargetStopsRefiningOnceEveryBlockIsDone) {
+  ViewOptions o = options();
+  o.spp = 512;
+  o.noise_target = 0.05;
+  ViewSession session(o);
+  ASSERT_TRUE(session.wait(done, 120));
+  const ViewFrame f = session.frame();
+  EXPECT_EQ(f.pixels_done, 1.0);
+  EXPECT_EQ(f.film_image->rgb,
+            reference(scene_, {"integrator.spp=512", "integrator.noise_target=0.05"}).rgb);
+  EXPECT_LT(f.samples_per_second * f.elapsed, 16.0 * 12 * 512 / 2);
+  // Without a target the frame has no share of pixels done.
+  ViewSession plain(options());
+  ASSERT_TRUE(plain.wait(done, 60));
+  EXPECT_EQ(plain.frame().pixels_done, -1);
+}
+
 TEST_F(Session, ShowsAPreviewWhileTheCameraMoves) {
   ViewOptions o = options();
   o.rest = 30;  // the camera never rests in this test
