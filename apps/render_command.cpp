@@ -170,8 +170,10 @@ int finish_render(const RenderArgs& args, const nimbus::RenderJob& job,
     return failed;
   const RenderSettings& s = job.scene().settings;
   if (r.stopped) {
-    // Of the samples a fixed spp would take: the most a render to a noise target takes.
-    const double done = 100 * double(held) / (double(s.width) * s.height * s.spp);
+    // Of the samples; with a noise target, of those it is predicted to take (noise_progress).
+    const NoiseRule rule = noise_rule(s);
+    const double done = 100 * (rule.on() ? noise_progress(rule, r.film).fraction
+                                         : double(held) / (double(s.width) * s.height * s.spp));
     if (r.checkpoint_failure.empty())
       std::fprintf(stderr,
                    "nimbus: stopped by %s at %.1f%% of the samples; wrote the image so far to %s "

@@ -135,10 +135,9 @@ void serve(WorkQueue& queue, JobChannel* channel, const SharedRenderSettings& s,
     // With a noise target, the share of the predicted samples, and of the pixels done
     // (render/noise_target.h): a pass over the film's blocks, so twice a second.
     if (s.progress && seconds_since(last_progress) > (queue.noise_target() ? 0.5 : 0.1)) {
-      if (queue.noise_target() && s.noise_progress) {
-        NoiseProgress p;
-        queue.with_film([&](const Film& film) { p = noise_progress(s.noise, film); });
-        s.noise_progress(p);
+      if (queue.noise_target()) {
+        const NoiseProgress p = queue.noise_progress();
+        if (s.noise_progress) s.noise_progress(p);
         s.progress(queue.finished() ? 1.0 : p.fraction);
       } else {
         s.progress(queue.fraction_done());
@@ -168,8 +167,8 @@ SharedRenderResult lead_shared_render(const Scene& scene, JobChannel* channel,
   // Four bands per rank at least, so every rank has lanes to take; at most 16 rows (the
   // renderer's tile), so the bands of a dense region are short.
   const int band_height = std::clamp(H / (4 * ranks), 1, 16);
-  s.noise = noise_rule(scene.settings);
-  WorkQueue queue(std::move(s.start), s.spp, band_height, ranks, s.unit_seconds, s.noise);
+  WorkQueue queue(std::move(s.start), s.spp, band_height, ranks, s.unit_seconds,
+                  noise_rule(scene.settings));
   // An exception on either thread ends the job: the other stops at its next pixel or poll, and
   // the exception leaves this function.
   std::atomic<bool> failed{false};

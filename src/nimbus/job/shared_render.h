@@ -32,7 +32,6 @@ struct SharedRenderSettings {
   std::function<void(double)> progress;  // fraction of the job done, on the lead
   // With a noise target, the film's progress towards it, on the lead, with `progress`.
   std::function<void(const NoiseProgress&)> noise_progress;
-  NoiseRule noise;             // set by lead_shared_render from the scene
   std::function<bool()> stop;  // polled; true: stop handing out and rendering units
 };
 

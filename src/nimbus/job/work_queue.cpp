@@ -219,8 +219,12 @@ bool WorkQueue::none_out() const {
 
 double WorkQueue::fraction_done() const {
   std::lock_guard lock(mutex_);
-  if (noise_.on()) return finished_locked() ? 1.0 : noise_progress(noise_, film_).fraction;
   return total_ > 0 ? done_ / total_ : 1.0;
+}
+
+NoiseProgress WorkQueue::noise_progress() const {
+  std::lock_guard lock(mutex_);
+  return nimbus::noise_progress(noise_, film_);
 }
 
 void WorkQueue::with_film(const std::function<void(const Film&)>& f) const {

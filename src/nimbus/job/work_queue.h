@@ -72,9 +72,10 @@ class WorkQueue {
 
   bool finished() const;  // every pixel holds spp samples (with a noise target, is done)
   bool stopped() const;
-  bool none_out() const;  // no unit handed out and not yet completed or abandoned
-  // Of the samples this job adds; with a noise target, of those predicted (noise_progress).
-  double fraction_done() const;
+  bool none_out() const;         // no unit handed out and not yet completed or abandoned
+  double fraction_done() const;  // of the samples this job adds (without a noise target)
+  // With a noise target, the film's progress towards it (render/noise_target.h).
+  NoiseProgress noise_progress() const;
   // Calls f with the job's film, the units out blocked meanwhile (to save a checkpoint).
   void with_film(const std::function<void(const Film&)>& f) const;
   Film film() const;

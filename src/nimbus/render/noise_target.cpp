@@ -27,11 +27,7 @@ int next_pass_end(const NoiseRule& rule, int n) {
 }
 
 bool is_pass_end(const NoiseRule& rule, int n) {
-  if (n >= rule.cap) return n == rule.cap;
-  const int n0 = first_pass_end(rule);
-  int end = n0;
-  while (end < n) end += std::max(n0, 2 * (end / 8));
-  return end == n;
+  return n == rule.cap || (n > 0 && n < rule.cap && next_pass_end(rule, n - 1) == n);
 }
 
 NoiseBlock noise_block(const Film& film, int bx, int by) {
