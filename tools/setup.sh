@@ -16,6 +16,8 @@ packages=(
   libopenmpi-dev openmpi-bin
   # `nimbus view`: its web server, and the browser its tests drive (tests/browser/)
   libmicrohttpd-dev chromium
+  # Blender 3.4: the add-on's tests run it headless (tests/blender, docs/blender.md)
+  blender
   # Embree 3: bench/embree_bvh, its kernels against our surface hierarchy (docs/benchmarks.md)
   libembree-dev
 )
