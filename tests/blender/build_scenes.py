@@ -70,6 +70,19 @@ def principled(name, **inputs):
     return material
 
 
+def node_material(name, node_type, output="Surface", **inputs):
+    """A material whose only node is `node_type` (e.g. "ShaderNodeEmission") into `output`."""
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    nodes = material.node_tree.nodes
+    nodes.remove(nodes["Principled BSDF"])
+    node = nodes.new(node_type)
+    for key, value in inputs.items():
+        node.inputs[key.replace("_", " ")].default_value = value
+    material.node_tree.links.new(node.outputs[0], nodes["Material Output"].inputs[output])
+    return material
+
+
 def add_sun(scene, strength=3.0, rotation=(math.radians(40), 0, math.radians(30))):
     data = bpy.data.lights.new("Sun", "SUN")
     data.energy = strength

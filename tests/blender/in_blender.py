@@ -119,13 +119,7 @@ def case_camera():
         cam.data.sensor_fit = fit
         cam.data.sensor_width, cam.data.sensor_height = 36.0, 24.0
         cam.data.ortho_scale = 3.5
-        emissive = bpy.data.materials.new("Light")
-        emissive.use_nodes = True
-        nodes = emissive.node_tree.nodes
-        nodes.remove(nodes["Principled BSDF"])
-        emission = nodes.new("ShaderNodeEmission")
-        emission.inputs["Strength"].default_value = 1.0
-        emissive.node_tree.links.new(emission.outputs[0], nodes["Material Output"].inputs[0])
+        emissive = bs.node_material("Light", "ShaderNodeEmission", Strength=1.0)
         for i, c in enumerate(centres):
             obj = bs.add_metaball(scene, f"Dot{i}", [{"co": (0, 0, 0), "radius": 0.2,
                                                       "stiffness": 2.0}], location=c)
@@ -150,13 +144,7 @@ def case_lights():
         floor = bs.add_metaball(scene, "Floor", [
             {"type": "ELLIPSOID", "co": (0, 0, -1.0), "radius": 1.0, "size": (40.0, 40.0, 1.0),
              "stiffness": 2.0}], threshold=0.6)
-        material = bpy.data.materials.new("White")
-        material.use_nodes = True
-        nodes = material.node_tree.nodes
-        nodes.remove(nodes["Principled BSDF"])
-        diffuse = nodes.new("ShaderNodeBsdfDiffuse")
-        diffuse.inputs["Color"].default_value = (0.8, 0.8, 0.8, 1)
-        material.node_tree.links.new(diffuse.outputs[0], nodes["Material Output"].inputs[0])
+        material = bs.node_material("White", "ShaderNodeBsdfDiffuse", Color=(0.8, 0.8, 0.8, 1))
         floor.data.materials.append(material)
         floor.data.render_resolution = 0.05
         data = bpy.data.lights.new("Light", kind)
@@ -212,15 +200,9 @@ def case_volume():
     obj.location = (0.3, 0.2, -0.1)
     obj.rotation_euler = (0.0, 0.0, 0.4)
     obj.scale = (1.5, 1.5, 1.5)
-    material = bpy.data.materials.new("Smoke")
-    material.use_nodes = True
-    nodes = material.node_tree.nodes
-    nodes.remove(nodes["Principled BSDF"])
-    volume = nodes.new("ShaderNodeVolumePrincipled")
-    volume.inputs["Density"].default_value = 4.0
-    volume.inputs["Color"].default_value = (0.9, 0.8, 0.7, 1)
-    volume.inputs["Absorption Color"].default_value = (0.25, 0.25, 0.25, 1)
-    material.node_tree.links.new(volume.outputs[0], nodes["Material Output"].inputs["Volume"])
+    material = bs.node_material("Smoke", "ShaderNodeVolumePrincipled", output="Volume",
+                                Density=4.0, Color=(0.9, 0.8, 0.7, 1),
+                                Absorption_Color=(0.25, 0.25, 0.25, 1))
     obj.data.materials.append(material)
     scene.nimbus.spp = 4
     export(os.path.join(OUT, "scene.json"))
