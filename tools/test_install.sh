@@ -60,4 +60,31 @@ if [ -d "$build/python/nimbus" ]; then
 nimbus.render(nimbus.load_file('$prefix/share/nimbus/scenes/vdb_fire.json', {'film.width': 8, 'film.height': 6}), spp=1)") ||
     { echo "test_install: the installed Python package does not run" >&2; exit 1; }
 fi
+# The Blender add-on, where the build has it and Blender is installed: from the install alone
+# it finds the installed module (its paths.json) and renders F12 (docs/blender.md).
+addon="$prefix/share/nimbus/blender/addons/nimbus_blender"
+if [ -d "$build/blender/addons/nimbus_blender" ]; then
+  [ -f "$addon/__init__.py" ] && [ -f "$addon/paths.json" ] ||
+    { echo "test_install: the Blender add-on was not installed" >&2; exit 1; }
+  if command -v blender > /dev/null; then
+    cat > "$work/f12.py" <<PY
+import bpy, addon_utils
+addon_utils.enable("nimbus_blender", default_set=True)
+from nimbus_blender import backend
+module = backend.load_module()
+assert module is not None and module.__file__.startswith("$python"), module
+scene = bpy.context.scene
+scene.render.engine = "NIMBUS"
+scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 16, 12, 100
+scene.nimbus.spp = 1
+scene.render.filepath = "$work/f12.png"
+bpy.ops.render.render(write_still=True)
+PY
+    (cd "$work" && env -u PYTHONPATH BLENDER_USER_SCRIPTS="$prefix/share/nimbus/blender" \
+      blender -b --factory-startup --python-exit-code 1 -P "$work/f12.py" > "$work/blender.log" 2>&1) ||
+      { tail -20 "$work/blender.log" >&2; echo "test_install: the installed add-on does not render" >&2; exit 1; }
+    [ -s "$work/f12.png" ] || { echo "test_install: the installed add-on wrote no image" >&2; exit 1; }
+    echo "test_install: the installed Blender add-on rendered F12 with the installed module"
+  fi
+fi
 echo "test_install: installed, built examples/embed outside the tree, rendered, ran an experiment"
