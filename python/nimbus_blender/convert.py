@@ -14,6 +14,12 @@ import numpy as np
 from . import metaball
 
 
+# The Principled BSDF's inputs that Blender 4.0 renamed or dropped: the name to read instead.
+_RENAMED = {"Transmission": "Transmission Weight", "Subsurface": "Subsurface Weight",
+            "Emission": "Emission Color", "Subsurface Color": "Base Color",
+            "Subsurface IOR": "IOR"}
+
+
 class ConversionError(ValueError):
     """A scene nimbus cannot render: no camera, a panoramic camera."""
 
@@ -171,7 +177,11 @@ class Converter:
 
     # --- materials ---------------------------------------------------------------------------
     def input_value(self, node, name, where):
-        socket = node.inputs[name]
+        """A socket's value; Blender 4's names of the Principled BSDF's inputs are read too, and
+        its inputs that Blender 4 dropped fall back to the ones that replace them."""
+        socket = node.inputs.get(name)
+        if socket is None:
+            socket = node.inputs[_RENAMED[name]]
         if socket.is_linked:
             self.warn(f"{where}: the {node.name} node's {name} input is linked; its own value is "
                       "used (textures and node networks are left out)")
@@ -269,13 +279,16 @@ class Converter:
         color = self.input_value(node, "Subsurface Color", where)
         anisotropy = self.input_value(node, "Subsurface Anisotropy", where)
         ior = max(self.input_value(node, "Subsurface IOR", where), 1.0)
+        # Blender 3 scales the radius by the weight; Blender 4 by its Subsurface Scale.
+        scale = (self.input_value(node, "Subsurface Scale", where)
+                 if "Subsurface Scale" in node.inputs else weight)
         albedo = [min(max(weight * color[i] + (1 - weight) * base[i], 0.0), 0.999) for i in range(3)]
         sigma_a, sigma_s = [], []
         for i in range(3):
             A = albedo[i]
             alpha = 1 - math.exp(-5.09406 * A + 2.61188 * A * A - 4.31805 * A ** 3)
             s = 1.9 - A + 3.5 * (A - 0.8) ** 2
-            d = max(weight * radius[i], 1e-6)
+            d = max(scale * radius[i], 1e-6)
             sigma_t = 1.0 / (d * s)
             sigma_s.append(_round(alpha * sigma_t))
             sigma_a.append(_round((1 - alpha) * sigma_t))
