@@ -85,7 +85,11 @@ class NimbusRenderEngine(bpy.types.RenderEngine):
         if done < spp:
             self.report({"WARNING"}, f"nimbus: render cancelled at {done} of {spp} samples per pixel")
         else:
-            self.report({"INFO"}, f"nimbus: {spp} spp in {time.monotonic() - started:.2f} s, "
+            samples = f"{spp} spp"
+            if document["integrator"].get("noise_target"):
+                samples = (f"{film.samples().mean():.1f} spp on average (noise target "
+                           f"{document['integrator']['noise_target']:g}, at most {spp})")
+            self.report({"INFO"}, f"nimbus: {samples} in {time.monotonic() - started:.2f} s, "
                                   f"first pixels after {first[0]:.2f} s")
 
     def render_with_executable(self, document, prefs):
