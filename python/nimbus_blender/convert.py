@@ -347,7 +347,7 @@ class Converter:
         steps, exact = _transform_steps(_matrix(matrix))
         if not exact:
             self.warn(f"{where}: its transform has shear, left out")
-        medium, grid = self.volume_medium(obj, where, gridded=True)
+        medium, grid = self.volume_medium(obj, where, {g.name for g in data.grids})
         density = {"type": "vdb", "file": path, "grid": grid}
         if steps:
             density["transform"] = steps
@@ -360,7 +360,7 @@ class Converter:
         self.shapes[name] = shape
         self.add_object(name, {"type": "none"}, name)
 
-    def volume_medium(self, obj, where, gridded=False):
+    def volume_medium(self, obj, where, grids=None):
         """A Principled Volume's coefficients at unit grid density (Cycles' definitions):
         sigma_s = density colour, sigma_a = density (1 - colour)(1 - sqrt(absorption colour))."""
         material = obj.active_material
@@ -388,20 +388,52 @@ class Converter:
             medium["phase"] = {"type": "hg", "g": _round(min(max(g, -0.99), 0.99))}
         emission = _rgb(self.input_value(node, "Emission Color", mwhere),
                         self.input_value(node, "Emission Strength", mwhere))
-        if any(e > 0 for e in emission):
-            if min(sigma_a) <= 0:
-                self.warn(f"{mwhere}: emission left out: nimbus's media emit sigma_a L_e, and this "
-                          "one does not absorb")
-            else:
-                # Cycles emits `emission` per unit length; nimbus sigma_a L_e.
-                medium["emission"] = [_round(emission[i] / sigma_a[i]) for i in range(3)]
-                if gridded:
-                    self.warn(f"{mwhere}: emission follows the density grid in nimbus (Cycles "
-                              "emits it uniformly where the volume is)")
-        if self.input_value(node, "Blackbody Intensity", mwhere) > 1e-3:
-            self.warn(f"{mwhere}: blackbody emission left out (Cycles' is not Planck's radiance; "
-                      "give the medium a temperature grid, docs/blender.md)")
+        blackbody = self.blackbody(node, mwhere, grids)
+        if blackbody is not None and any(e > 0 for e in emission):
+            self.warn(f"{mwhere}: its emission colour left out: nimbus's medium emits one colour, "
+                      "here the blackbody's")
+        if (blackbody is not None or any(e > 0 for e in emission)) and min(sigma_a) <= 0:
+            self.warn(f"{mwhere}: emission left out: nimbus's media emit sigma_a L_e, and this one "
+                      "does not absorb")
+        elif blackbody is not None:
+            # Cycles emits e per unit length: a blackbody's colour whose luminance is e; nimbus
+            # sigma_a L_e, so L_e is that colour at luminance e / sigma_a.
+            kelvin, luminance = blackbody
+            mean = sum(sigma_a) / 3
+            if max(sigma_a) - min(sigma_a) > 1e-6 * mean:
+                self.warn(f"{mwhere}: the blackbody is divided by the mean absorption (nimbus's "
+                          "blackbody colour has one scale)")
+            medium["emission"] = {"blackbody": _round(kelvin), "scale": _round(luminance / mean)}
+        elif any(e > 0 for e in emission):
+            # Cycles emits `emission` per unit length; nimbus sigma_a L_e.
+            medium["emission"] = [_round(emission[i] / sigma_a[i]) for i in range(3)]
+        if "emission" in medium and grids is not None:
+            self.warn(f"{mwhere}: emission follows the density grid in nimbus (Cycles emits it "
+                      "uniformly where the volume is)")
         return medium, grid
+
+    def blackbody(self, node, where, grids):
+        """(kelvin, luminance per unit length) of a Principled Volume's blackbody emission, or None:
+        Cycles emits a blackbody colour of luminance 10^-6 sigma_SB T^4 / pi at full intensity
+        (sigma_SB the Stefan-Boltzmann constant), mixed with 1 by the intensity, at T = the
+        Temperature input (times the temperature grid, where the volume has one: left out)."""
+        intensity = self.input_value(node, "Blackbody Intensity", where)
+        if intensity <= 1e-3:
+            return None
+        attribute = node.inputs["Temperature Attribute"].default_value
+        if grids is not None and attribute in grids:
+            self.warn(f"{where}: blackbody emission from the temperature grid left out: Cycles "
+                      "scales it as T^4, nimbus's temperature grids are Planck's radiance "
+                      "(docs/blender.md)")
+            return None
+        kelvin = self.input_value(node, "Temperature", where)
+        if kelvin < 100:
+            return None
+        tint = self.input_value(node, "Blackbody Tint", where)
+        if any(abs(c - 1) > 1e-6 for c in tint[:3]):
+            self.warn(f"{where}: the blackbody tint left out")
+        sigma = 5.670373e-8 * 1e-6 / math.pi
+        return kelvin, sigma * ((1 - intensity) + intensity * kelvin ** 4)
 
     def add_object(self, shape, surface, medium):
         obj = {"shape": shape, "surface": surface}

@@ -172,6 +172,36 @@ def case_lights():
         result["lights"].append({"kind": kind, "radius": radius, "nimbus": path, "cycles": cycles})
 
 
+def case_volume_emission():
+    """A metaball slab filled with an absorbing, emitting Principled Volume (an emission colour,
+    then a blackbody), seen face-on by an orthographic camera: F12 with nimbus and with Cycles."""
+    result["volumes"] = []
+    for name, inputs in [("colour", {"Emission Strength": 2.0,
+                                     "Emission Color": (1.0, 0.5, 0.25, 1.0)}),
+                         ("blackbody", {"Blackbody Intensity": 1.0, "Temperature": 2500.0})]:
+        scene = bs.empty_scene(8, 8)
+        cam = bs.add_camera(scene, location=(0, 0, 3.0), target=(0, 0, 0), kind="ORTHO")
+        cam.data.ortho_scale = 0.2
+        slab = bs.add_metaball(scene, "Slab", [
+            {"type": "ELLIPSOID", "co": (0, 0, 0), "radius": 1.0, "size": (8.0, 8.0, 0.5),
+             "stiffness": 2.0}], threshold=0.6)
+        slab.data.render_resolution = 0.05
+        slab.data.materials.append(bs.node_material(
+            "Glow", "ShaderNodeVolumePrincipled", output="Volume", Density=20.0,
+            Color=(0.0, 0.0, 0.0, 1.0), Absorption_Color=(0.0, 0.0, 0.0, 1.0),
+            **{k.replace(" ", "_"): v for k, v in inputs.items()}))
+        scene.world = None
+        scene.nimbus.spp = 16
+        path = os.path.join(OUT, f"{name}_nimbus.exr")
+        render(path)
+        scene.render.engine = "CYCLES"
+        scene.cycles.samples = 16
+        scene.cycles.use_denoising = False
+        cycles = os.path.join(OUT, f"{name}_cycles.exr")
+        render(cycles)
+        result["volumes"].append({"name": name, "nimbus": path, "cycles": cycles})
+
+
 def case_world():
     scene = bs.empty_scene(16, 12)
     bs.add_camera(scene)

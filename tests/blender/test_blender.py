@@ -122,6 +122,20 @@ def test_light_power_is_cycles(tmp_path):
         np.testing.assert_allclose(ours, cycles, rtol=0.01, err_msg=str(light))
 
 
+def test_volume_emission_is_cycles(tmp_path):
+    """An absorbing slab's emission (a colour times a strength, then a 2 500 K blackbody at full
+    intensity) against Cycles' render of it: within 0.3 % (measured: 10⁻⁵, and 0.12 % in the
+    blackbody's blue). The slab is optically thick (depth 11), so both show e / sigma_a whatever
+    their surfaces (nimbus's exact one, Cycles' marching cubes); Cycles' blackbody colours are a
+    fit to Planck's law, nimbus's its projection."""
+    result, _ = blender("volume_emission", tmp_path)
+    for volume in result["volumes"]:
+        ours = nimbus.read_exr(volume["nimbus"]).mean(axis=(0, 1))
+        cycles = nimbus.read_exr(volume["cycles"]).mean(axis=(0, 1))
+        assert ours.max() > 0.02
+        np.testing.assert_allclose(ours, cycles, rtol=0.003, err_msg=str(volume))
+
+
 def test_world_colour_and_strength(tmp_path):
     result, output = blender("world", tmp_path)
     image = nimbus.read_exr(str(tmp_path / "world.exr"))
