@@ -142,11 +142,11 @@ def case_lights():
         cam = bs.add_camera(scene, location=(0, 0, 1.0), target=(0, 0, -1.0), kind="ORTHO")
         cam.data.ortho_scale = 0.3
         floor = bs.add_metaball(scene, "Floor", [
-            {"type": "ELLIPSOID", "co": (0, 0, -1.0), "radius": 1.0, "size": (40.0, 40.0, 1.0),
+            {"type": "ELLIPSOID", "co": (0, 0, -1.0), "radius": 1.0, "size": (6.0, 6.0, 1.0),
              "stiffness": 2.0}], threshold=0.6)
         material = bs.node_material("White", "ShaderNodeBsdfDiffuse", Color=(0.8, 0.8, 0.8, 1))
         floor.data.materials.append(material)
-        floor.data.render_resolution = 0.05
+        floor.data.render_resolution = 0.1   # Cycles' mesh of it: flat where the camera looks
         data = bpy.data.lights.new("Light", kind)
         data.energy = 3.0 if kind == "SUN" else 500.0
         data.color = (1.0, 0.8, 0.6)
