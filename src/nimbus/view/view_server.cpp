@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -54,6 +55,8 @@ struct Answer {
   std::string body;
   const char* type = "application/json";
   std::vector<std::pair<std::string, std::string>> headers;
+  // A body shared with the session (the meshes, megabytes): sent from where it is, not copied.
+  std::shared_ptr<const std::string> shared_body = nullptr;
 };
 
 Answer error(unsigned status, const std::string& message) {
@@ -216,9 +219,10 @@ struct ViewServer::Impl {
       const ViewFrame f = session.frame();
       if (!f.meshes) return error(404, "no meshes yet");
       return Answer{200,
-                    *f.meshes,
+                    {},
                     "application/octet-stream",
-                    {{"X-Nimbus-Meshes", std::to_string(f.mesh_version)}}};
+                    {{"X-Nimbus-Meshes", std::to_string(f.mesh_version)}},
+                    f.meshes};
     }
     if (get && url == "/save.exr") return save("exr");
     if (get && url == "/save.png") return save("png");
@@ -235,10 +239,18 @@ struct ViewServer::Impl {
     return error(404, fmt::format("{} {}: not found", method, url));
   }
 
-  MHD_Result answer(MHD_Connection* c, const Answer& a) {
-    MHD_Response* response = MHD_create_response_from_buffer(
-        a.body.size(), const_cast<char*>(a.body.data()), MHD_RESPMEM_MUST_COPY);
-    if (!response) return MHD_NO;
+  MHD_Result answer(MHD_Connection* c, Answer a) {
+    // The response keeps the body alive until the server has sent it, then frees it.
+    auto* body = new std::shared_ptr<const std::string>(
+        a.shared_body ? std::move(a.shared_body)
+                      : std::make_shared<const std::string>(std::move(a.body)));
+    MHD_Response* response = MHD_create_response_from_buffer_with_free_callback_cls(
+        (*body)->size(), const_cast<char*>((*body)->data()),
+        [](void* kept) { delete static_cast<std::shared_ptr<const std::string>*>(kept); }, body);
+    if (!response) {
+      delete body;
+      return MHD_NO;
+    }
     MHD_add_response_header(response, "Content-Type", a.type);
     MHD_add_response_header(response, "Cache-Control", "no-store");
     for (const auto& [name, value] : a.headers)
@@ -254,7 +266,7 @@ struct ViewServer::Impl {
                           const Request& r, bool body_done) {
     try {
       const std::optional<Answer> a = route(c, method, url, r, body_done);
-      return a ? answer(c, *a) : MHD_YES;
+      return a ? answer(c, std::move(*a)) : MHD_YES;
     } catch (const std::exception& e) {
       return answer(c, error(500, e.what()));
     }
