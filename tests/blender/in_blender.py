@@ -290,6 +290,17 @@ def case_bad_input():
     export(os.path.join(OUT, "cancelled.json"))
     scene.nimbus.spp = 2
     render(os.path.join(OUT, "after.exr"))
+
+    # Scenes nimbus cannot render, and exports it cannot write: one line each.
+    bpy.ops.export_scene.nimbus(filepath=os.path.join(OUT, "before_camera.json"))
+    scene.camera.data.type = "PANO"
+    result["panoramic_export"] = reports_of(
+        lambda: export(os.path.join(OUT, "pano.json")))
+    scene.camera = None
+    result["no_camera"] = reports_of(lambda: export(os.path.join(OUT, "none.json")))
+    result["missing_folder"] = reports_of(
+        lambda: export(os.path.join(OUT, "no", "such", "folder", "scene.json")))
+    result["written"] = sorted(n for n in os.listdir(OUT) if n.endswith(".json"))
     result["blender_went_on"] = True
 
 

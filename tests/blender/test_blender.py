@@ -180,6 +180,13 @@ def test_bad_input_gives_one_line_each_and_blender_goes_on(tmp_path):
     cancelled = nimbus.read_exr(str(tmp_path / "cancelled.exr"))
     cli = cli_render(tmp_path / "cancelled.json", tmp_path / "cli4.exr", "--spp", "4")
     assert np.array_equal(cancelled, cli)
+    for key, line in [("panoramic_export", 'camera "Camera": panoramic cameras are not supported'),
+                      ("no_camera", "the scene has no camera"),
+                      ("missing_folder", "does not exist")]:
+        ok, message = result[key]
+        assert not ok and line in message and message.count("\n") <= 1, (key, message)
+    # Nothing is written where an export failed.
+    assert result["written"] == ["before_camera.json", "cancelled.json"]
     assert result["blender_went_on"]
 
 
