@@ -43,8 +43,8 @@ def main():
     p.add_argument("--reps", type=int, default=5)
     p.add_argument("--exe", default=os.path.join(here, "build", "nimbus"))
     a = p.parse_args()
-    env = dict(os.environ, BLENDER_USER_SCRIPTS=os.path.join(os.path.dirname(os.path.abspath(a.exe)),
-                                                             "blender"))
+    build = os.path.dirname(os.path.abspath(a.exe))
+    env = dict(os.environ, BLENDER_USER_SCRIPTS=os.path.join(build, "blender"))
     f12, first, cli = [], [], []
     with tempfile.TemporaryDirectory() as folder:
         script = os.path.join(folder, "inside.py")

@@ -282,7 +282,8 @@ class Converter:
         # Blender 3 scales the radius by the weight; Blender 4 by its Subsurface Scale.
         scale = (self.input_value(node, "Subsurface Scale", where)
                  if "Subsurface Scale" in node.inputs else weight)
-        albedo = [min(max(weight * color[i] + (1 - weight) * base[i], 0.0), 0.999) for i in range(3)]
+        albedo = [min(max(weight * color[i] + (1 - weight) * base[i], 0.0), 0.999)
+                  for i in range(3)]
         sigma_a, sigma_s = [], []
         for i in range(3):
             A = albedo[i]
@@ -327,7 +328,8 @@ class Converter:
                         self.warn(f'metaball "{obj.name}": element {index} has no volume; left out')
                         continue
                     perturbations.append({
-                        "shape": {"type": "quadric", "coefficients": [_round(c) for c in coefficients]},
+                        "shape": {"type": "quadric",
+                                  "coefficients": [_round(c) for c in coefficients]},
                         "weight": _round(metaball.element_weight(el.stiffness, el.use_negative))})
             if not any(p["weight"] > 0 for p in perturbations):
                 self.warn(f'metaball "{basis.name}": no positive element; nothing to render')
@@ -340,7 +342,10 @@ class Converter:
         data = obj.data
         where = f'volume "{obj.name}"'
         path = os.path.abspath(_blender_abspath(data.filepath))
-        data.grids.load()
+        if not data.grids.load():
+            # Blender could not read it either: no bounds to hold it, and nothing to render.
+            message = data.grids.error_message or "cannot be read"
+            raise ConversionError(f"{where}: {path}: {message}")
         corners = np.array([[float(c) for c in corner] for corner in obj.bound_box])
         lo, hi = corners.min(axis=0), corners.max(axis=0)
         pad = 1e-3 * max(float(np.max(hi - lo)), 1e-6)
@@ -380,8 +385,8 @@ class Converter:
         absorption = self.input_value(node, "Absorption Color", mwhere)
         grid = node.inputs["Density Attribute"].default_value or "density"
         sigma_s = [density * max(color[i], 0.0) for i in range(3)]
-        sigma_a = [density * max(1 - color[i], 0.0) * max(1 - math.sqrt(max(absorption[i], 0.0)), 0.0)
-                   for i in range(3)]
+        sigma_a = [density * max(1 - color[i], 0.0)
+                   * max(1 - math.sqrt(max(absorption[i], 0.0)), 0.0) for i in range(3)]
         medium = {"sigma_a": [_round(c) for c in sigma_a], "sigma_s": [_round(c) for c in sigma_s]}
         g = self.input_value(node, "Anisotropy", mwhere)
         if g != 0:

@@ -1,5 +1,4 @@
 """The render engine: F12 renders the scene with nimbus into Blender's render result."""
-import os
 import shutil
 import time
 
@@ -83,7 +82,8 @@ class NimbusRenderEngine(bpy.types.RenderEngine):
             return
         self.end_result(result)
         if done < spp:
-            self.report({"WARNING"}, f"nimbus: render cancelled at {done} of {spp} samples per pixel")
+            self.report({"WARNING"},
+                        f"nimbus: render cancelled at {done} of {spp} samples per pixel")
         else:
             samples = f"{spp} spp"
             if document["integrator"].get("noise_target"):

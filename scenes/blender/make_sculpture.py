@@ -106,7 +106,8 @@ camera_data.lens = 40
 camera = bpy.data.objects.new("Camera", camera_data)
 scene.collection.objects.link(camera)
 camera.location = (3.6, -6.4, 2.2)
-camera.rotation_euler = (Vector((0.0, 0.5, 1.2)) - camera.location).to_track_quat("-Z", "Y").to_euler()
+look = Vector((0.0, 0.5, 1.2)) - camera.location
+camera.rotation_euler = look.to_track_quat("-Z", "Y").to_euler()
 scene.camera = camera
 
 try:
