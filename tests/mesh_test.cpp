@@ -6,6 +6,7 @@
 
 #include "nimbus/mesh/mesh.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
@@ -152,10 +153,13 @@ TEST(Polygonize, FreeFormWithFourPerturbations) {
 
 // A spike: a thin upright ellipsoid perturbing a ball. Its tip, the exact surface's highest point
 // on the axis, must be in the mesh within 2ε.
-// The dihedral angles of the mesh edges that lie on a sharp edge of the shape (both ends and the
-// midpoint): `on_edge` says whether a point is on it.
+// The mesh edges that lie on a sharp edge of the shape (both ends and the midpoint): their
+// dihedral angles and lengths. `on_edge` says whether a point is on it.
+struct MeshEdge {
+  double angle, length;
+};
 template <class OnEdge>
-std::vector<double> sharp_edge_angles(const TriangleMesh& m, OnEdge&& on_edge) {
+std::vector<MeshEdge> sharp_edges(const TriangleMesh& m, OnEdge&& on_edge) {
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<Vec3>> faces;
   for (const auto& t : m.triangles) {
     const Vec3 n = normalize(
@@ -165,18 +169,18 @@ std::vector<double> sharp_edge_angles(const TriangleMesh& m, OnEdge&& on_edge) {
       faces[{std::min(a, b), std::max(a, b)}].push_back(n);
     }
   }
-  std::vector<double> angles;
-  for (const auto& [edge, normals] : faces)
-    if (normals.size() == 2 && on_edge(m.positions[edge.first]) &&
-        on_edge(m.positions[edge.second]) &&
-        on_edge((m.positions[edge.first] + m.positions[edge.second]) * 0.5))
-      angles.push_back(std::acos(std::clamp(dot(normals[0], normals[1]), -1.0, 1.0)) * 180 / kPi);
-  return angles;
+  std::vector<MeshEdge> edges;
+  for (const auto& [edge, normals] : faces) {
+    const Vec3 &a = m.positions[edge.first], &b = m.positions[edge.second];
+    if (normals.size() == 2 && on_edge(a) && on_edge(b) && on_edge((a + b) * 0.5))
+      edges.push_back({std::acos(std::clamp(dot(normals[0], normals[1]), -1.0, 1.0)) * 180 / kPi,
+                       length(b - a)});
+  }
+  return edges;
 }
 
 // A CSG edge is kept: the mesh edges along a cylinder's rim, cut by a slab, meet at 90° within
-// 5° (a curved sharp edge: issue 43). A box turned off the grid's axes is not yet (docs/meshes.md,
-// "Limits": chamfers where a cell sees one face of the edge).
+// 5° (a curved sharp edge: issue 43).
 TEST(Polygonize, CylinderCutBySlabKeepsItsRim) {
   const double eps = 0.003;
   const Tape cylinder = tape_of(R"({"type": "intersection", "shapes": [
@@ -190,9 +194,69 @@ TEST(Polygonize, CylinderCutBySlabKeepsItsRim) {
   const auto on_rim = [&](const Vec3& p) {
     return std::abs(std::hypot(p.x, p.y) - 0.5) <= eps && std::abs(std::abs(p.z) - 0.8) <= eps;
   };
-  const std::vector<double> rim_angles = sharp_edge_angles(c.mesh, on_rim);
-  EXPECT_GE(rim_angles.size(), 16u);
-  for (double a : rim_angles) EXPECT_NEAR(a, 90, 5);
+  const std::vector<MeshEdge> rim = sharp_edges(c.mesh, on_rim);
+  EXPECT_GE(rim.size(), 16u);
+  for (const MeshEdge& e : rim) EXPECT_NEAR(e.angle, 90, 5);
+}
+
+// A box turned off the grid's axes keeps its edges and corners (docs/meshes.md, step 5): a
+// mesh edge that crosses a sharp edge is split on it, and a face across a corner at the corner.
+// The mesh edges along the box's edges cover them, every one meets at 90° within 5°, and each
+// corner is a vertex. Three turns, three bounds.
+TEST(Polygonize, TurnedBoxKeepsItsEdgesAndCorners) {
+  const Vec3 half{0.5, 0.4, 0.3};
+  struct Turn {
+    Vec3 axis;
+    double degrees, eps;
+  };
+  for (const Turn& turn : {Turn{{1, 2, 3}, 25, 0.003}, Turn{{1, 2, 3}, 25, 0.001},
+                           Turn{{-2, 1, 0.5}, 40, 0.003}, Turn{{0, 0, 1}, 30, 0.002}}) {
+    SCOPED_TRACE(turn.degrees);
+    const double eps = turn.eps;
+    const Vec3 axis = normalize(turn.axis);
+    const Tape box = tape_of(fmt::format(
+        R"({{"type": "box", "min": [-0.5, -0.4, -0.3], "max": [0.5, 0.4, 0.3],
+            "transform": [{{"rotate": {{"axis": [{}, {}, {}], "degrees": {}}}}}]}})",
+        turn.axis.x, turn.axis.y, turn.axis.z, turn.degrees));
+    const Checked c = mesh_and_check(box, eps);
+    EXPECT_EQ(c.topology.euler, 2);
+    // Rodrigues' rotation by `degrees` about the axis.
+    const auto rotate = [&](const Vec3& p, double degrees) {
+      const double cs = std::cos(degrees * kPi / 180), sn = std::sin(degrees * kPi / 180);
+      return p * cs + cross(axis, p) * sn + axis * (dot(axis, p) * (1 - cs));
+    };
+    // A point within a tenth of ε of two faces: on the edge, not on a face beside it.
+    const double tol = 0.1 * eps;
+    const auto on_edge = [&](const Vec3& p) {
+      const Vec3 q = rotate(p, -turn.degrees);
+      int faces = 0;
+      for (int k = 0; k < 3; ++k) {
+        if (std::abs(q[k]) > half[k] + tol) return false;
+        faces += std::abs(std::abs(q[k]) - half[k]) <= tol;
+      }
+      return faces >= 2;
+    };
+    // A mesh edge this near the sharp edge is either on it (90°) or beside it in one face (0°,
+    // both its faces in one plane); a chamfer or a turned face would be in between.
+    double kept = 0;
+    int off = 0;
+    for (const MeshEdge& e : sharp_edges(c.mesh, on_edge)) {
+      if (std::abs(e.angle - 90) <= 5)
+        kept += e.length;
+      else if (e.angle > 5)
+        ++off;
+    }
+    EXPECT_GE(kept, 0.99 * 8 * (half.x + half.y + half.z));
+    EXPECT_EQ(off, 0);
+    for (int corner = 0; corner < 8; ++corner) {
+      const Vec3 q{corner & 1 ? half.x : -half.x, corner & 2 ? half.y : -half.y,
+                   corner & 4 ? half.z : -half.z};
+      const Vec3 p = rotate(q, turn.degrees);
+      double nearest = kInf;
+      for (const Vec3& v : c.mesh.positions) nearest = std::min(nearest, length(v - p));
+      EXPECT_LE(nearest, 0.01 * eps) << "corner " << corner;
+    }
+  }
 }
 
 TEST(Polygonize, ThinFreeFormSpikeKeepsItsTip) {
@@ -211,26 +275,31 @@ TEST(Polygonize, ThinFreeFormSpikeKeepsItsTip) {
   EXPECT_NEAR(top, tip, 2 * eps);
 }
 
+// A free form, and a turned box whose sharp edges and corners are split (docs/meshes.md, step 5).
 TEST(Polygonize, SameMeshForAnyThreadCount) {
-  const Tape tape = tape_of(R"({"type": "freeform",
+  for (const char* shape : {R"({"type": "freeform",
       "base": {"type": "ellipsoid", "radii": [0.9, 0.7, 0.8]},
       "perturbations": [{"shape": {"type": "sphere", "center": [0.5, 0.4, 0], "radius": 0.4},
-                         "weight": 1}]})");
-  TriangleMesh one, two;
-  {
-    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
-    one = polygonize(tape, {3e-3, 0});
-  }
-  {
-    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
-    two = polygonize(tape, {3e-3, 0});
-  }
-  ASSERT_EQ(one.positions.size(), two.positions.size());
-  ASSERT_EQ(one.triangles, two.triangles);
-  for (size_t i = 0; i < one.positions.size(); ++i) {
-    EXPECT_EQ(one.positions[i].x, two.positions[i].x);
-    EXPECT_EQ(one.positions[i].y, two.positions[i].y);
-    EXPECT_EQ(one.positions[i].z, two.positions[i].z);
+                         "weight": 1}]})",
+                            R"({"type": "box", "min": [-0.5, -0.4, -0.3], "max": [0.5, 0.4, 0.3],
+      "transform": [{"rotate": {"axis": [1, 2, 3], "degrees": 25}}]})"}) {
+    const Tape tape = tape_of(shape);
+    TriangleMesh one, two;
+    {
+      tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
+      one = polygonize(tape, {3e-3, 0});
+    }
+    {
+      tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
+      two = polygonize(tape, {3e-3, 0});
+    }
+    ASSERT_EQ(one.positions.size(), two.positions.size());
+    ASSERT_EQ(one.triangles, two.triangles);
+    for (size_t i = 0; i < one.positions.size(); ++i) {
+      EXPECT_EQ(one.positions[i].x, two.positions[i].x);
+      EXPECT_EQ(one.positions[i].y, two.positions[i].y);
+      EXPECT_EQ(one.positions[i].z, two.positions[i].z);
+    }
   }
 }
 

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <array>
@@ -42,6 +43,12 @@ constexpr int kMaxAxisCells = (1 << 21) - 2;
 // A cell whose corners share a sign is searched for a hidden piece of the shape down to boxes
 // this many times smaller (or the error bound, if larger).
 constexpr double kHiddenSearch = 8;
+// Normals more than 30° apart at a mesh edge's ends may be those of two faces of a sharp edge
+// between them (split_folds).
+constexpr double kFoldCos = 0.8660254037844387;
+// A point where sharp edges meet is taken where F changes sign within this fraction of the error
+// bound of it: exact to round-off where the faces are planes.
+constexpr double kFoldTolerance = 0.01;
 // Cells per task when the pruning recursion runs in parallel.
 constexpr std::int64_t kParallelCells = 4096;
 
@@ -257,6 +264,18 @@ bool hides_other_sign(const Tape& tape, const Box& box, bool inside, double dept
   return false;
 }
 
+// Whether a face (a, b, c) has three points in a line (three cells' vertices on one sharp edge),
+// and so no normal, or is turned against the surface's normal (two vertices on a sharp edge in
+// the other order along it than their cells): `outward`, or the gradient's at its centroid.
+bool misshapen(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& outward) {
+  const Vec3 u = b - a, w = c - a, n = cross(u, w);
+  if (length(n) <= 1e-6 * std::max(dot(u, u), dot(w, w))) return true;
+  return dot(n, outward) < 0;
+}
+bool misshapen(const Tape& tape, const Vec3& a, const Vec3& b, const Vec3& c) {
+  return misshapen(a, b, c, outward(tape, (a + b + c) / 3.0));
+}
+
 GridMesh mesh_grid(const Tape& tape, const Grid& g, double error) {
   GridMesh out;
   std::vector<Cell> cells = collect(tape, g, {0, 0, 0}, g.n);
@@ -363,7 +382,7 @@ GridMesh mesh_grid(const Tape& tape, const Grid& g, double error) {
   mesh.normals.resize(total);
   std::vector<double> vertex_error(cells.size(), 0);
   // Vertices: each loop's quadratic error function over its edges' roots; then onto the
-  // surface along the gradient where it is more than ε/2 away.
+  // surface.
   tbb::parallel_for(std::size_t{0}, cells.size(), [&](std::size_t i) {
     const CellVertices& v = loops[i];
     if (v.loops == 0) return;
@@ -387,7 +406,8 @@ GridMesh mesh_grid(const Tape& tape, const Grid& g, double error) {
       const std::vector<EdgePoint>& pts = points[size_t(loop)];
       Vec3 mass{0, 0, 0};
       Vec3 x = qef_vertex(pts, box, mass);
-      // Onto the surface where it is more than ε/2 away: along the gradient, or where that line
+      // Onto the surface, so that a face's vertices lie in the planes of the faces of the shape
+      // they stand for (split_folds needs them there): along the gradient, or where that line
       // misses it (outside a curved sharp edge, past both faces), towards the mass point of the
       // edges' roots, which lies on the solid's side of the edge.
       Vec3 n = outward(tape, x);
@@ -401,11 +421,8 @@ GridMesh mesh_grid(const Tape& tape, const Grid& g, double error) {
           d = 2 * g.h;
           continue;
         }
-        d = std::abs(*t);
-        if (d > 0.5 * error) {
-          x = x + u * *t;
-          d = 0;
-        }
+        x = x + u * *t;
+        d = 0;
         break;
       }
       const Vec3 m = outward(tape, x);
@@ -453,7 +470,16 @@ GridMesh mesh_grid(const Tape& tape, const Grid& g, double error) {
                                           normalize(nn[q[0]] + nn[q[2]] + Vec3{0, 0, 1e-12}), g.h);
       const double d13 = surface_distance(tape, (p[q[1]] + p[q[3]]) * 0.5,
                                           normalize(nn[q[1]] + nn[q[3]] + Vec3{0, 0, 1e-12}), g.h);
-      if (d02 < d13 || (d02 == d13 && length(p[q[0]] - p[q[2]]) <= length(p[q[1]] - p[q[3]]))) {
+      // Not a split with a face of three points in a line, or turned over (misshapen, against
+      // its vertices' normals).
+      const auto bad = [&](std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+        return misshapen(p[x], p[y], p[z], nn[x] + nn[y] + nn[z]);
+      };
+      const bool bad02 = bad(q[0], q[1], q[2]) || bad(q[0], q[2], q[3]);
+      const bool bad13 = bad(q[0], q[1], q[3]) || bad(q[1], q[2], q[3]);
+      if (bad02 != bad13 ? bad13
+                         : d02 < d13 || (d02 == d13 &&
+                                         length(p[q[0]] - p[q[2]]) <= length(p[q[1]] - p[q[3]]))) {
         triangles[i].push_back({q[0], q[1], q[2]});
         triangles[i].push_back({q[0], q[2], q[3]});
       } else {
@@ -654,6 +680,155 @@ std::optional<Vec3> nearest_surface_point(const Tape& tape, const Vec3& p, const
   return best;
 }
 
+// How far inside the surface p lies to first order, F/|∇F| (negative outside): exact where F is
+// a plane's signed distance.
+double first_order_depth(const Tape& tape, const Vec3& p) {
+  const double g = length(gradient(tape, p));
+  return g > 0 ? evaluate(tape, p) / g : 0;
+}
+
+// Where a mesh edge (a, b) crosses a sharp edge of the shape (its ends on two faces, their normals
+// apart), the point of the sharp edge between them: where the tangent planes at a and b meet the
+// plane through a and b that holds their mean normal. None where the planes are near parallel,
+// the point is not between a and b, or the surface is not there (a smooth bend, whose tangent
+// planes meet off it).
+std::optional<Vec3> fold_point(const Tape& tape, const Vec3& pa, const Vec3& na, const Vec3& pb,
+                               const Vec3& nb, double tolerance) {
+  if (dot(na, nb) > kFoldCos) return std::nullopt;
+  // The tangent planes n·x = d through the surface near each end, where a vertex a root search
+  // left a little off it (first order, exact for a plane).
+  const double da = dot(na, pa) + first_order_depth(tape, pa);
+  const double db = dot(nb, pb) + first_order_depth(tape, pb);
+  const Vec3 ab = pb - pa;
+  // Each end off the other's tangent plane: an end already on the sharp edge needs no point
+  // beside it (which would make a face of three points on the edge).
+  const double off = 0.05 * length(ab);
+  if (std::abs(dot(nb, pa) - db) <= off || std::abs(dot(na, pb) - da) <= off) return std::nullopt;
+  const Vec3 side = cross(ab, na + nb);
+  if (!(length(side) > 0)) return std::nullopt;
+  const Vec3 s = normalize(side);
+  // Cramer's rule for na·x = da, nb·x = db, s·x = s·pa.
+  const double det = dot(na, cross(nb, s));
+  if (std::abs(det) < 0.25) return std::nullopt;
+  const double ds = dot(s, pa);
+  const Vec3 x = (cross(nb, s) * da + cross(s, na) * db + cross(na, nb) * ds) / det;
+  const double t = dot(x - pa, ab) / dot(ab, ab);
+  if (!(t > 0.05 && t < 0.95)) return std::nullopt;
+  // On the surface: F changes sign within the tolerance along the mean normal.
+  if (!sign_change_within(tape, x, normalize(na + nb), tolerance)) return std::nullopt;
+  return x;
+}
+
+// The corner where three planes (points p, normals n) pairwise apart meet, if the surface is
+// there; none where they are near parallel or it is not.
+std::optional<Vec3> corner_point(const Tape& tape, const std::array<Vec3, 3>& p,
+                                 const std::array<Vec3, 3>& n, double tolerance) {
+  for (int k = 0; k < 3; ++k)
+    if (dot(n[size_t(k)], n[size_t(k + 1) % 3]) > kFoldCos) return std::nullopt;
+  // Cramer's rule for n_k·x = n_k·p_k.
+  const double det = dot(n[0], cross(n[1], n[2]));
+  if (std::abs(det) < 0.25) return std::nullopt;
+  const Vec3 x = (cross(n[1], n[2]) * dot(n[0], p[0]) + cross(n[2], n[0]) * dot(n[1], p[1]) +
+                  cross(n[0], n[1]) * dot(n[2], p[2])) /
+                 det;
+  if (!sign_change_within(tape, x, normalize(n[0] + n[1] + n[2]), tolerance)) return std::nullopt;
+  return x;
+}
+
+// A closed mesh whose edges are split at a point in both faces that share them, so that it stays
+// closed and 2-manifold, with the orientation kept.
+class EdgeSplitter {
+ public:
+  explicit EdgeSplitter(TriangleMesh& m) : m_(m) {
+    faces_of_.reserve(m.triangles.size() * 3 / 2);
+    for (std::uint32_t i = 0; i < m.triangles.size(); ++i)
+      for (int k = 0; k < 3; ++k)
+        attach(m.triangles[i][size_t(k)], m.triangles[i][size_t(k + 1) % 3], i);
+  }
+  // The vertices opposite edge k of face t, (a, b) in its order: c in t and d in the other face
+  // that shares the edge; none where the edge has one face only.
+  std::optional<std::array<std::uint32_t, 2>> opposite(std::uint32_t t, int k) const {
+    const auto u = beside(t, k);
+    if (!u) return std::nullopt;
+    const Face f = m_.triangles[t], g = m_.triangles[*u];
+    int j = 0;
+    while (g[size_t(j)] == f[size_t(k)] || g[size_t(j)] == f[size_t(k + 1) % 3]) ++j;
+    return std::array<std::uint32_t, 2>{f[size_t(k + 2) % 3], g[size_t(j)]};
+  }
+  // The face that shares edge k of face t; none where the edge has one face only.
+  std::optional<std::uint32_t> beside(std::uint32_t t, int k) const {
+    const Face f = m_.triangles[t];
+    const auto& pair = faces_of_.at(key(f[size_t(k)], f[size_t(k + 1) % 3]));
+    const std::uint32_t u = pair[0] == t ? pair[1] : pair[0];
+    if (u == kNone) return std::nullopt;
+    return u;
+  }
+  // Splits face t = (a, b, c) at p (normal n) into (a, b, v), (b, c, v) and (c, a, v): the three
+  // faces.
+  std::array<std::uint32_t, 3> split_face(std::uint32_t t, const Vec3& p, const Vec3& n) {
+    const Face f = m_.triangles[t];
+    const std::uint32_t a = f[0], b = f[1], c = f[2];
+    const std::uint32_t v = add_vertex(p, n);
+    const auto t1 = std::uint32_t(m_.triangles.size()), t2 = t1 + 1;
+    m_.triangles[t] = {a, b, v};
+    m_.triangles.push_back({b, c, v});
+    m_.triangles.push_back({c, a, v});
+    replace(b, c, t, t1);
+    replace(c, a, t, t2);
+    faces_of_[key(b, v)] = {t, t1};
+    faces_of_[key(c, v)] = {t1, t2};
+    faces_of_[key(a, v)] = {t2, t};
+    return {t, t1, t2};
+  }
+  // Splits edge k of face t, (a, b) in its order, at p (normal n): the four faces changed or
+  // added, or none where the edge has one face only.
+  std::optional<std::array<std::uint32_t, 4>> split(std::uint32_t t, int k, const Vec3& p,
+                                                    const Vec3& n) {
+    const auto cd = opposite(t, k);
+    if (!cd) return std::nullopt;
+    const std::uint32_t a = m_.triangles[t][size_t(k)], b = m_.triangles[t][size_t(k + 1) % 3];
+    const std::uint32_t c = (*cd)[0], d = (*cd)[1], u = *beside(t, k);
+    const std::uint32_t v = add_vertex(p, n);
+    // t = (a, b, c) becomes (a, v, c) and t1 = (v, b, c); u = (b, a, d) becomes (b, v, d) and
+    // u1 = (v, a, d): the orientation kept.
+    const auto t1 = std::uint32_t(m_.triangles.size()), u1 = t1 + 1;
+    m_.triangles[t] = {a, v, c};
+    m_.triangles.push_back({v, b, c});
+    m_.triangles[u] = {b, v, d};
+    m_.triangles.push_back({v, a, d});
+    faces_of_.erase(key(a, b));
+    replace(b, c, t, t1);
+    replace(a, d, u, u1);
+    faces_of_[key(a, v)] = {t, u1};
+    faces_of_[key(v, b)] = {t1, u};
+    faces_of_[key(v, c)] = {t, t1};
+    faces_of_[key(v, d)] = {u, u1};
+    return std::array<std::uint32_t, 4>{t, t1, u, u1};
+  }
+
+ private:
+  using Face = std::array<std::uint32_t, 3>;
+  static constexpr std::uint32_t kNone = ~std::uint32_t{0};
+  static std::uint64_t key(std::uint32_t a, std::uint32_t b) {
+    return (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
+  }
+  std::uint32_t add_vertex(const Vec3& p, const Vec3& n) {
+    m_.positions.push_back(p);
+    m_.normals.push_back(n);
+    return std::uint32_t(m_.positions.size() - 1);
+  }
+  void attach(std::uint32_t a, std::uint32_t b, std::uint32_t face) {
+    auto [it, fresh] = faces_of_.try_emplace(key(a, b), std::array<std::uint32_t, 2>{face, kNone});
+    if (!fresh) it->second[1] = face;
+  }
+  void replace(std::uint32_t a, std::uint32_t b, std::uint32_t from, std::uint32_t to) {
+    auto& f = faces_of_.at(key(a, b));
+    (f[0] == from ? f[0] : f[1]) = to;
+  }
+  TriangleMesh& m_;
+  std::unordered_map<std::uint64_t, std::array<std::uint32_t, 2>> faces_of_;  // each edge's faces
+};
+
 // Makes good the faces further than `error` from the surface by bisecting them, rather than by
 // refining the whole grid: where few faces fail (chamfers along a sharp edge off the grid's axes,
 // whose depth falls only as the cell), a failing face's longest edge is split at its midpoint
@@ -665,25 +840,7 @@ std::optional<Vec3> nearest_surface_point(const Tape& tape, const Vec3& p, const
 // pass max_faces.
 bool bisect_failing_faces(const Tape& tape, TriangleMesh& m, std::vector<double>& distance,
                           double error, double near, double reach, std::size_t max_faces) {
-  using Face = std::array<std::uint32_t, 3>;
-  constexpr std::uint32_t kNone = ~std::uint32_t{0};
-  const auto key = [](std::uint32_t a, std::uint32_t b) {
-    return (std::uint64_t(std::min(a, b)) << 32) | std::max(a, b);
-  };
-  // Each edge's two faces.
-  std::unordered_map<std::uint64_t, std::array<std::uint32_t, 2>> faces_of;
-  faces_of.reserve(m.triangles.size() * 3 / 2);
-  const auto attach = [&](std::uint32_t a, std::uint32_t b, std::uint32_t face) {
-    auto [it, fresh] = faces_of.try_emplace(key(a, b), std::array<std::uint32_t, 2>{face, kNone});
-    if (!fresh) it->second[1] = face;
-  };
-  const auto replace = [&](std::uint32_t a, std::uint32_t b, std::uint32_t from, std::uint32_t to) {
-    auto& f = faces_of.at(key(a, b));
-    (f[0] == from ? f[0] : f[1]) = to;
-  };
-  for (std::uint32_t i = 0; i < m.triangles.size(); ++i)
-    for (int k = 0; k < 3; ++k)
-      attach(m.triangles[i][size_t(k)], m.triangles[i][size_t(k + 1) % 3], i);
+  EdgeSplitter splitter(m);
   std::deque<std::uint32_t> failing;
   for (std::uint32_t i = 0; i < m.triangles.size(); ++i)
     if (distance[i] > error) failing.push_back(i);
@@ -696,50 +853,111 @@ bool bisect_failing_faces(const Tape& tape, TriangleMesh& m, std::vector<double>
     measured[t] = 1;
     if (distance[t] <= error) continue;
     if (m.triangles.size() + 2 > max_faces) return false;
-    // The longest edge, as (a, b) in the face's order, and c the third vertex.
-    Face f = m.triangles[t];
+    // The longest edge, k: (a, b) in the face's order.
+    const auto& f = m.triangles[t];
     int k = 0;
     for (int j = 1; j < 3; ++j)
       if (length(m.positions[f[size_t(j)]] - m.positions[f[size_t(j + 1) % 3]]) >
           length(m.positions[f[size_t(k)]] - m.positions[f[size_t(k + 1) % 3]]))
         k = j;
-    const std::uint32_t a = f[size_t(k)], b = f[size_t(k + 1) % 3], c = f[size_t(k + 2) % 3];
-    const auto& pair = faces_of.at(key(a, b));
-    const std::uint32_t u = pair[0] == t ? pair[1] : pair[0];
-    if (u == kNone) return false;
-    const Face g = m.triangles[u];
-    int j = 0;
-    while (g[size_t(j)] == a || g[size_t(j)] == b) ++j;
-    const std::uint32_t d = g[size_t(j)];
+    const std::uint32_t a = f[size_t(k)], b = f[size_t(k + 1) % 3];
     const Vec3 n = m.normals[a] + m.normals[b];
     const auto p = nearest_surface_point(tape, (m.positions[a] + m.positions[b]) * 0.5,
                                          length(n) > 0 ? normalize(n) : Vec3{0, 0, 1}, reach);
     if (!p || length(m.positions[a] - m.positions[b]) < 1e-9 * reach) return false;
-    const auto v = std::uint32_t(m.positions.size());
-    m.positions.push_back(*p);
     const Vec3 nv = outward(tape, *p);
-    m.normals.push_back(length(nv) > 0 ? nv : normalize(n));
-    // t = (a, b, c) becomes (a, v, c) and t1 = (v, b, c); u = (b, a, d) becomes (b, v, d) and
-    // u1 = (v, a, d): the orientation kept.
-    const auto t1 = std::uint32_t(m.triangles.size()), u1 = t1 + 1;
-    m.triangles[t] = {a, v, c};
-    m.triangles.push_back({v, b, c});
-    m.triangles[u] = {b, v, d};
-    m.triangles.push_back({v, a, d});
+    const auto changed = splitter.split(t, k, *p, length(nv) > 0 ? nv : normalize(n));
+    if (!changed) return false;
     // Each changed face is measured again when it is taken from the queue.
     distance.resize(m.triangles.size(), std::numeric_limits<double>::infinity());
     measured.resize(m.triangles.size(), 0);
-    measured[t] = measured[u] = 0;
-    faces_of.erase(key(a, b));
-    replace(b, c, t, t1);
-    replace(a, d, u, u1);
-    faces_of[key(a, v)] = {t, u1};
-    faces_of[key(v, b)] = {t1, u};
-    faces_of[key(v, c)] = {t, t1};
-    faces_of[key(v, d)] = {u, u1};
-    for (std::uint32_t face : {t, t1, u, u1}) failing.push_back(face);
+    for (std::uint32_t face : *changed) {
+      measured[face] = 0;
+      failing.push_back(face);
+    }
   }
   return true;
+}
+
+// Splits each mesh edge that crosses a sharp edge of the shape at the sharp edge's point between
+// its ends (fold_point), in both faces that share it, until no edge crosses one: a chamfer
+// face (a cell that sees one face of an edge off the grid's axes) becomes two faces, one on each
+// side, meeting on the sharp edge. Sequential, in the faces' order: the same mesh for any
+// number of threads. At most `max_splits` splits.
+void split_folds(const Tape& tape, TriangleMesh& m, double tolerance, std::size_t max_splits) {
+  // A smooth surface's neighbouring normals are near: most meshes have no edge to split.
+  const bool any = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, m.triangles.size()), false,
+      [&](const tbb::blocked_range<std::size_t>& range, bool found) {
+        for (std::size_t i = range.begin(); i != range.end() && !found; ++i)
+          for (int k = 0; k < 3 && !found; ++k)
+            found = dot(m.normals[m.triangles[i][size_t(k)]],
+                        m.normals[m.triangles[i][size_t(k + 1) % 3]]) <= kFoldCos;
+        return found;
+      },
+      [](bool a, bool b) { return a || b; });
+  if (!any) return;
+  EdgeSplitter splitter(m);
+  std::deque<std::uint32_t> queue(m.triangles.size());
+  std::iota(queue.begin(), queue.end(), 0);
+  std::size_t splits = 0;
+  while (!queue.empty() && splits < max_splits) {
+    const std::uint32_t t = queue.front();
+    queue.pop_front();
+    bool done = false;
+    for (int k = 0; k < 3 && !done; ++k) {
+      const std::uint32_t a = m.triangles[t][size_t(k)], b = m.triangles[t][size_t(k + 1) % 3];
+      const auto x =
+          fold_point(tape, m.positions[a], m.normals[a], m.positions[b], m.normals[b], tolerance);
+      if (!x) continue;
+      // The four faces it would make, none misshapen: a fold point at a corner may lie beyond
+      // the faces beside the edge.
+      const auto cd = splitter.opposite(t, k);
+      if (!cd) continue;
+      const auto& p = m.positions;
+      const Vec3 &pa = p[a], &pb = p[b], &pc = p[(*cd)[0]], &pd = p[(*cd)[1]];
+      if (misshapen(tape, pa, *x, pc) || misshapen(tape, *x, pb, pc) ||
+          misshapen(tape, pb, *x, pd) || misshapen(tape, *x, pa, pd))
+        continue;
+      const Vec3 nv = outward(tape, *x);
+      const auto changed =
+          splitter.split(t, k, *x, length(nv) > 0 ? nv : normalize(m.normals[a] + m.normals[b]));
+      if (!changed) continue;
+      ++splits;
+      for (std::uint32_t face : *changed) queue.push_back(face);
+      done = true;
+    }
+    if (done) continue;
+    // A corner: where the planes of the three faces beside this one meet (a face whose three
+    // edges are on three sharp edges, each beside a face of the shape), the face split in three.
+    const auto f = m.triangles[t];
+    const auto& p = m.positions;
+    std::array<Vec3, 3> plane_point, plane_normal;
+    bool planes = true;
+    for (int k = 0; k < 3 && planes; ++k) {
+      const auto u = splitter.beside(t, k);
+      if (!u) {
+        planes = false;
+        break;
+      }
+      const auto& g = m.triangles[*u];
+      const Vec3 n = cross(p[g[1]] - p[g[0]], p[g[2]] - p[g[0]]);
+      planes = length(n) > 0;
+      if (planes) {
+        plane_point[size_t(k)] = p[g[0]];
+        plane_normal[size_t(k)] = normalize(n);
+      }
+    }
+    if (!planes) continue;
+    const auto x = corner_point(tape, plane_point, plane_normal, tolerance);
+    if (!x || misshapen(tape, p[f[0]], p[f[1]], *x) || misshapen(tape, p[f[1]], p[f[2]], *x) ||
+        misshapen(tape, p[f[2]], p[f[0]], *x))
+      continue;
+    const Vec3 nv = outward(tape, *x);
+    ++splits;
+    for (std::uint32_t face : splitter.split_face(t, *x, length(nv) > 0 ? nv : m.normals[f[0]]))
+      queue.push_back(face);
+  }
 }
 
 }  // namespace
@@ -750,6 +968,13 @@ double distance_along(const Tape& tape, const Vec3& p, const Vec3& d, double rea
 }
 
 double surface_distance(const Tape& tape, const Vec3& p, const Vec3& n, double reach) {
+  // A point on a sharp edge to round-off, whose normal lies in the other face: F is zero along
+  // that line, and the search would report its far end. A sign change within a hair along one
+  // of the fixed directions shows the surface there.
+  const double hair = 1e-9 * reach;
+  if (std::abs(evaluate(tape, p)) <= hair * length(gradient(tape, p)))
+    for (const Vec3& w : fixed_directions())
+      if (sign_change_within(tape, p, w, hair)) return hair;
   double d = distance_along(tape, p, n, reach);
   if (d < reach) return d;
   const Vec3 g = outward(tape, p);
@@ -801,6 +1026,7 @@ TriangleMesh polygonize(const Tape& tape, const PolygonizeOptions& options,
           "the limit is {}",
           options.error, double(previous_cells) * growth, h, options.max_cells));
     GridMesh gm = mesh_grid(tape, g, options.error);
+    split_folds(tape, gm.mesh, kFoldTolerance * options.error, gm.mesh.triangles.size());
     ++r.grids;
     r.cell = h;
     r.cells = gm.cells;
