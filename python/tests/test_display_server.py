@@ -75,11 +75,15 @@ class StandIn(threading.Thread):
         self.updates.append(updates)
 
     def run(self):
+        # Told to stop, it still serves every connection already made (a loaded machine may run
+        # this thread only after the render has ended): it stops once none is pending.
         first = True
-        while not self.stop:
+        while True:
             try:
                 conn, _ = self.server.accept()
             except socket.timeout:
+                if self.stop:
+                    break
                 continue
             self.serve(conn, first)
             first = False

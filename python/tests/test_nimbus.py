@@ -144,9 +144,10 @@ def test_other_threads_run_while_rendering():
     stop.set()
     t.join()
     during = [x for x in ticks if start < x < end]
-    # The render holds the GIL only between its 50 ms polls: the ticker runs throughout.
+    # The render holds the GIL only between its 50 ms polls: the ticker runs throughout (ten
+    # ticks at the least, however loaded the machine; none if the render held the GIL).
     assert end - start > 0.2
-    assert len(during) > 0.5 * (end - start) / 0.005 * 0.2
+    assert len(during) >= 10
 
 
 def test_ctrl_c_ends_a_render_with_keyboard_interrupt():
@@ -161,7 +162,8 @@ def test_ctrl_c_ends_a_render_with_keyboard_interrupt():
     sent = time.monotonic()
     child.send_signal(signal.SIGINT)
     _, err = child.communicate(timeout=30)
-    assert time.monotonic() - sent < 1.5
+    # Promptly: the render would take minutes (a loaded machine may take seconds to schedule it).
+    assert time.monotonic() - sent < 20
     assert child.returncode != 0
     assert "KeyboardInterrupt" in err
 
