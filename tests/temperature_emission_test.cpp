@@ -21,6 +21,7 @@
 #include <functional>
 #include <string>
 
+#include "nimbus/math/constants.h"
 #include "nimbus/render/renderer.h"
 #include "nimbus/scene/compile.h"
 #include "nimbus/scene/load.h"
@@ -48,8 +49,8 @@ test::FloatGrid grid_of(const std::string& name, const test::Coord& lo, const te
   return g;
 }
 
-// The luminance of Planck's radiance at T.
-double planck_luminance(double kelvin) {
+// The luminance of Planck's radiance at T, computed here rather than from planck.h's table.
+double luminance_of_planck(double kelvin) {
   return linear_srgb_to_xyz(emission_to_rgb(planck_spectrum(kelvin))).y;
 }
 
@@ -117,7 +118,7 @@ TEST_P(TemperatureGrid, ConstantTemperatureRendersAsTheBlackbodyColour) {
   constexpr double kKelvin = 1800, kEnv = 0.5;
   test::write_vdb(dir.file("fire.vdb"), {grid_of("temperature", {-3, -3, -3}, {13, 13, 13},
                                                  [](int, int, int) { return kKelvin; })});
-  const double s = 2 / planck_luminance(kKelvin);  // luminance 2
+  const double s = 2 / luminance_of_planck(kKelvin);  // luminance 2
   const std::string camera =
       R"({"type": "orthographic", "from": [0.5, 0.5, 3], "to": [0.5, 0.5, 0], "width": 0.8})";
   const std::string box = R"({"type": "box", "min": [0, 0, 0], "max": [1, 1, 1]})";
@@ -131,7 +132,7 @@ TEST_P(TemperatureGrid, ConstantTemperatureRendersAsTheBlackbodyColour) {
       render_file(dir, "colour.json",
                   absorber_scene(mode, camera, 1, box,
                                  fmt::format(R"({{"blackbody": {}, "scale": {:.17g}}})", kKelvin,
-                                             s * planck_luminance(kKelvin)),
+                                             s * luminance_of_planck(kKelvin)),
                                  kEnv, 512));
 
   // The grid's emission at points: Planck's radiance inside, none beyond the active voxels.
@@ -181,7 +182,7 @@ TEST_P(TemperatureGrid, GradientMatchesQuadratureAlongTheRay) {
   test::write_vdb(dir.file("fire.vdb"),
                   {grid_of("heat", {-3, -3, -3}, {23, 13, 13},
                            [&](int i, int, int) { return kelvin_at(i * kVoxel); })});
-  const double s = 1 / planck_luminance(3000);
+  const double s = 1 / luminance_of_planck(3000);
   const RenderResult r = render_file(
       dir, "gradient.json",
       absorber_scene(
@@ -215,16 +216,95 @@ TEST_P(TemperatureGrid, GradientMatchesQuadratureAlongTheRay) {
   EXPECT_LT(largest_standard_error(r.film), 0.05);
 }
 
+// Emission per unit length (Cycles' convention) under the Stefan–Boltzmann law, in a slab that
+// neither absorbs nor scatters: its grid holds T / 1000 and "temperature_scale" 1000 makes it T,
+// rising linearly from 1000 K at x = 0 to 3000 K at x = 2, and a cloud density that is 0 in
+// places, which emission per unit length ignores. Seen along −x every pixel is
+// ∫₀² j(T(x)) dx + L_env with j(T) = s σ T⁴/π · B(·, T)/Y(T), by Simpson's rule. Nothing
+// collides there, so the emission is all the track-length estimator's (render/glow.h). A
+// gradient 2 % hotter fails. A constant 1800 K grid renders as the {"blackbody": 1800} colour of
+// luminance s σ 1800⁴/π per unit length, to the table's rounding.
+TEST_P(TemperatureGrid, PerLengthStefanBoltzmannMatchesQuadrature) {
+  const std::string mode = GetParam();
+  const TempDir dir("temperature_per_length");
+  constexpr double kLength = 2, kEnv = 0.2, kScale = 1e-6;
+  const auto kelvin_at = [](double x) { return 1000 + 1000 * x; };
+  test::write_vdb(dir.file("fire.vdb"),
+                  {grid_of("heat", {-3, -3, -3}, {23, 13, 13},
+                           [&](int i, int, int) { return kelvin_at(i * kVoxel) / 1000; }),
+                   grid_of("hot", {-3, -3, -3}, {23, 13, 13}, [](int, int, int) { return 1.8; })});
+  const auto scene_text = [&](const std::string& j) {
+    return fmt::format(R"({{
+      "film": {{"width": 8, "height": 8}},
+      "camera": {{"type": "orthographic", "from": [4, 0.5, 0.5], "to": [0, 0.5, 0.5],
+                  "width": 0.8}},
+      "integrator": {{"spp": 1024, "seed": 9, "sampler": "independent"}},
+      "spectrum": {{"mode": "{}", "wavelengths": 4}},
+      "lights": [{{"type": "environment", "radiance": {}}}],
+      "media": {{"fire": {{"sigma_s": 0, "density": {{"type": "cloud"}},
+                          "emission_per_length": {}}}}},
+      "objects": [{{"shape": {{"type": "box", "min": [0, 0, 0], "max": [2, 1, 1]}},
+                   "medium": "fire"}}]
+    }})",
+                       mode, kEnv, j);
+  };
+  const auto grid_j = [&](const std::string& grid) {
+    return fmt::format(R"({{"file": "fire.vdb", "grid": "{}", "law": "stefan-boltzmann",
+                           "scale": {}, "temperature_scale": 1000}})",
+                       grid, kScale);
+  };
+  Scene scene;
+  const RenderResult r = render_file(dir, "gradient.json", scene_text(grid_j("heat")), &scene);
+  ASSERT_EQ(scene.glowing_objects.size(), 1u);
+  const auto j_of = [&](double kelvin) {
+    Rgb B = emission_to_rgb(planck_spectrum(kelvin));
+    if (mode == "rgb")  // rgb mode clamps each point's emission, so the reference does too
+      for (int c = 0; c < 3; ++c) B[c] = std::max(B[c], 0.0);
+    return B *
+           (kScale * kStefanBoltzmann * std::pow(kelvin, 4) / kPi / luminance_of_planck(kelvin));
+  };
+  const auto quadrature = [&](const std::function<double(double)>& kelvin_at_depth) {
+    constexpr int kSteps = 2000;
+    const double h = kLength / kSteps;
+    Rgb sum(0.0);
+    for (int k = 0; k <= kSteps; ++k) {
+      const double w = k == 0 || k == kSteps ? 1 : k % 2 ? 4 : 2;
+      sum += j_of(kelvin_at_depth(k * h)) * w;
+    }
+    const Rgb L = sum * (h / 3) + environment_rgb(mode, kEnv);
+    return [L](int) { return L; };
+  };
+  const test::Chi2 right =
+      test::film_chi2(r.film, quadrature([&](double t) { return kelvin_at(kLength - t); }));
+  const test::Chi2 hotter =
+      test::film_chi2(r.film, quadrature([&](double t) { return 1.02 * kelvin_at(kLength - t); }));
+  EXPECT_EQ(right.dof, 8 * 8 * 3);
+  EXPECT_TRUE(right.passes()) << right.value << " for " << right.dof;
+  EXPECT_FALSE(hotter.passes()) << hotter.value << " for " << hotter.dof;
+
+  const RenderResult grid = render_file(dir, "hot.json", scene_text(grid_j("hot")));
+  const RenderResult colour =
+      render_file(dir, "colour.json",
+                  scene_text(fmt::format(R"({{"blackbody": 1800, "scale": {:.17g}}})",
+                                         kScale * kStefanBoltzmann * std::pow(1800.0, 4) / kPi)));
+  const double largest = j_of(1800).max_abs() * kLength;
+  for (int p = 0; p < grid.film.pixels(); ++p)
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(grid.film.mean(p)[c], colour.film.mean(p)[c], 1e-6 * largest)
+          << "pixel " << p << " channel " << c;
+}
+
 INSTANTIATE_TEST_SUITE_P(Modes, TemperatureGrid, testing::Values("rgb", "spectral"),
                          [](const testing::TestParamInfo<std::string>& info) {
                            return info.param;
                          });
 
-// The error of a scene in `dir` whose medium "m" has the given emission.
-std::string load_error(const TempDir& dir, const std::string& emission) {
+// The error of a scene in `dir` whose medium "m" has the given emission (at `key`).
+std::string load_error(const TempDir& dir, const std::string& emission,
+                       const std::string& key = "emission") {
   std::ofstream(dir.file("scene.json"))
-      << R"({"camera": {"from": [0, 0, 5], "to": [0, 0, 0]}, "media": {"m": {"sigma_a": 1, )"
-      << R"("emission": )" << emission << "}}}";
+      << R"({"camera": {"from": [0, 0, 5], "to": [0, 0, 0]}, "media": {"m": {"sigma_a": 1, ")"
+      << key << R"(": )" << emission << "}}}";
   try {
     compile_scene(load_scene_file(dir.file("scene.json")));  // the grid is read by compiling
   } catch (const SceneError& e) {
@@ -282,6 +362,10 @@ TEST(TemperatureGridErrors, BadInputIsOneLineNamingTheJsonPathAndTheFile) {
       {R"({"grid": "flames"})", at + "/file: required key is missing"},
       {R"({"file": "nowhere.vdb", "sclae": 2})",
        at + R"(/sclae: unknown key for a temperature grid's emission (did you mean "scale"?))"},
+      {R"({"file": "smoke.vdb", "grid": "flames", "law": "cycles"})",
+       at + R"(/law: unknown law "cycles" (expected one of: planck, stefan-boltzmann))"},
+      {R"({"file": "smoke.vdb", "grid": "flames", "temperature_scale": -1})",
+       at + "/temperature_scale: must be in [0, 1e+30]"},
   };
   for (const Case& c : cases) {
     const std::string e = load_error(dir, c.emission);
@@ -292,6 +376,16 @@ TEST(TemperatureGridErrors, BadInputIsOneLineNamingTheJsonPathAndTheFile) {
   EXPECT_EQ(load_error(dir, R"({"file": "smoke.vdb", "grid": "flames", "scale": 0.5})"),
             "(no error)");
   EXPECT_EQ(load_error(dir, R"({"blackbody": 1500})"), "(no error)");
+  // Emission per unit length takes the same grids and colours, with the same checks.
+  const std::string per_length = dir.file("scene.json") + ": /media/m/emission_per_length";
+  EXPECT_EQ(load_error(dir, R"({"file": "smoke.vdb", "grid": "heat"})", "emission_per_length"),
+            per_length + "/grid: " + dir.file("smoke.vdb") +
+                R"(: grid "heat" is not in the file (the file holds grids "density", "flames"))");
+  EXPECT_EQ(load_error(dir, "-0.5", "emission_per_length"), per_length + ": must be in [0, 1e+30]");
+  EXPECT_EQ(load_error(dir, R"({"file": "smoke.vdb", "grid": "flames", "law": "stefan-boltzmann"})",
+                       "emission_per_length"),
+            "(no error)");
+  EXPECT_EQ(load_error(dir, "[0.1, 0.2, 0.3]", "emission_per_length"), "(no error)");
 }
 
 // As a program: a scene whose temperature grid is missing exits 2 with that one line and writes

@@ -357,6 +357,11 @@ class Converter:
         if steps:
             density["transform"] = steps
         medium["density"] = density
+        glow = medium.get("emission_per_length")
+        if isinstance(glow, dict) and "grid" in glow:
+            glow["file"] = path
+            if steps:
+                glow["transform"] = steps
         name = obj.name
         self.media[name] = medium
         shape = {"type": "box", "min": _vector(lo - pad), "max": _vector(hi + pad)}
@@ -393,52 +398,52 @@ class Converter:
             medium["phase"] = {"type": "hg", "g": _round(min(max(g, -0.99), 0.99))}
         emission = _rgb(self.input_value(node, "Emission Color", mwhere),
                         self.input_value(node, "Emission Strength", mwhere))
+        # Cycles emits e per unit length, whatever the density: nimbus's emission_per_length.
+        # Where the density is constant and the medium absorbs alike in every channel it is
+        # nimbus's sigma_a L_e with L_e = e / sigma_a, which its trackers collect where paths are
+        # absorbed: exactly the same light, with less noise in dense media (docs/blender.md).
         blackbody = self.blackbody(node, mwhere, grids)
         if blackbody is not None and any(e > 0 for e in emission):
-            self.warn(f"{mwhere}: its emission colour left out: nimbus's medium emits one colour, "
-                      "here the blackbody's")
-        if (blackbody is not None or any(e > 0 for e in emission)) and min(sigma_a) <= 0:
-            self.warn(f"{mwhere}: emission left out: nimbus's media emit sigma_a L_e, and this one "
-                      "does not absorb")
-        elif blackbody is not None:
-            # Cycles emits e per unit length: a blackbody's colour whose luminance is e; nimbus
-            # sigma_a L_e, so L_e is that colour at luminance e / sigma_a.
-            kelvin, luminance = blackbody
-            mean = sum(sigma_a) / 3
-            if max(sigma_a) - min(sigma_a) > 1e-6 * mean:
-                self.warn(f"{mwhere}: the blackbody is divided by the mean absorption (nimbus's "
-                          "blackbody colour has one scale)")
-            medium["emission"] = {"blackbody": _round(kelvin), "scale": _round(luminance / mean)}
-        elif any(e > 0 for e in emission):
-            # Cycles emits `emission` per unit length; nimbus sigma_a L_e.
+            self.warn(f"{mwhere}: its emission colour left out: nimbus's medium emits one colour "
+                      "per unit length, here the blackbody's")
+        glow = blackbody if blackbody is not None else (
+            [_round(e) for e in emission] if any(e > 0 for e in emission) else None)
+        absorbs = grids is None and min(sigma_a) > 0
+        if glow is None:
+            pass
+        elif isinstance(glow, list) and absorbs:
             medium["emission"] = [_round(emission[i] / sigma_a[i]) for i in range(3)]
-        if "emission" in medium and grids is not None:
-            self.warn(f"{mwhere}: emission follows the density grid in nimbus (Cycles emits it "
-                      "uniformly where the volume is)")
+        elif "blackbody" in glow and absorbs and max(sigma_a) - min(sigma_a) <= 1e-9 * max(sigma_a):
+            medium["emission"] = {"blackbody": glow["blackbody"],
+                                  "scale": _round(glow["scale"] / sigma_a[0])}
+        else:
+            medium["emission_per_length"] = glow
         return medium, grid
 
     def blackbody(self, node, where, grids):
-        """(kelvin, luminance per unit length) of a Principled Volume's blackbody emission, or None:
-        Cycles emits a blackbody colour of luminance 10^-6 sigma_SB T^4 / pi at full intensity
-        (sigma_SB the Stefan-Boltzmann constant), mixed with 1 by the intensity, at T = the
-        Temperature input (times the temperature grid, where the volume has one: left out)."""
+        """A Principled Volume's blackbody emission per unit length, or None. Cycles emits a
+        blackbody colour of luminance 10^-6 sigma_SB T^4 / pi at full intensity (sigma_SB the
+        Stefan-Boltzmann constant), mixed with 1 by the intensity, at T = the Temperature input
+        times the temperature grid where the volume has one: a {"blackbody": T} colour, or a
+        temperature grid under the Stefan-Boltzmann law (its "file" and "transform" are the
+        density's, which the caller adds)."""
         intensity = self.input_value(node, "Blackbody Intensity", where)
         if intensity <= 1e-3:
-            return None
-        attribute = node.inputs["Temperature Attribute"].default_value
-        if grids is not None and attribute in grids:
-            self.warn(f"{where}: blackbody emission from the temperature grid left out: Cycles "
-                      "scales it as T^4, nimbus's temperature grids are Planck's radiance "
-                      "(docs/blender.md)")
-            return None
-        kelvin = self.input_value(node, "Temperature", where)
-        if kelvin < 100:
             return None
         tint = self.input_value(node, "Blackbody Tint", where)
         if any(abs(c - 1) > 1e-6 for c in tint[:3]):
             self.warn(f"{where}: the blackbody tint left out")
-        sigma = 5.670373e-8 * 1e-6 / math.pi
-        return kelvin, sigma * ((1 - intensity) + intensity * kelvin ** 4)
+        kelvin = self.input_value(node, "Temperature", where)
+        attribute = node.inputs["Temperature Attribute"].default_value
+        if grids is not None and attribute in grids:
+            # Cycles' (1 - intensity) share, 1.8e-14 per unit length, is left out.
+            return {"grid": attribute, "law": "stefan-boltzmann",
+                    "scale": _round(1e-6 * intensity), "temperature_scale": _round(kelvin)}
+        if kelvin < 100:
+            return None
+        sigma = 5.670374419e-8 * 1e-6 / math.pi
+        return {"blackbody": _round(kelvin),
+                "scale": _round(sigma * ((1 - intensity) + intensity * kelvin ** 4))}
 
     def add_object(self, shape, surface, medium):
         obj = {"shape": shape, "surface": surface}

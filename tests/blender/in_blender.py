@@ -178,7 +178,10 @@ def case_volume_emission():
     result["volumes"] = []
     for name, inputs in [("colour", {"Emission Strength": 2.0,
                                      "Emission Color": (1.0, 0.5, 0.25, 1.0)}),
-                         ("blackbody", {"Blackbody Intensity": 1.0, "Temperature": 2500.0})]:
+                         ("blackbody", {"Blackbody Intensity": 1.0, "Temperature": 2500.0}),
+                         # Density 0: it neither absorbs nor scatters, and emits all the same.
+                         ("glow", {"Density": 0.0, "Emission Strength": 0.5,
+                                   "Emission Color": (1.0, 0.5, 0.25, 1.0)})]:
         scene = bs.empty_scene(8, 8)
         cam = bs.add_camera(scene, location=(0, 0, 3.0), target=(0, 0, 0), kind="ORTHO")
         cam.data.ortho_scale = 0.2
@@ -187,9 +190,10 @@ def case_volume_emission():
              "stiffness": 2.0}], threshold=0.6)
         slab.data.render_resolution = 0.05
         slab.data.materials.append(bs.node_material(
-            "Glow", "ShaderNodeVolumePrincipled", output="Volume", Density=20.0,
-            Color=(0.0, 0.0, 0.0, 1.0), Absorption_Color=(0.0, 0.0, 0.0, 1.0),
-            **{k.replace(" ", "_"): v for k, v in inputs.items()}))
+            "Glow", "ShaderNodeVolumePrincipled", output="Volume",
+            **{"Density": 20.0, "Color": (0.0, 0.0, 0.0, 1.0),
+               "Absorption_Color": (0.0, 0.0, 0.0, 1.0),
+               **{k.replace(" ", "_"): v for k, v in inputs.items()}}))
         scene.world = None
         scene.nimbus.spp = 16
         path = os.path.join(OUT, f"{name}_nimbus.exr")
@@ -200,6 +204,33 @@ def case_volume_emission():
         cycles = os.path.join(OUT, f"{name}_cycles.exr")
         render(cycles)
         result["volumes"].append({"name": name, "nimbus": path, "cycles": cycles})
+
+
+def case_fire():
+    """The flame of scenes/vdb/vdb_fire.vdb as a VDB volume object that only glows: a Principled
+    Volume of density 0 whose blackbody reads the temperature grid (Temperature 1: the grid holds
+    kelvin), seen along z by an orthographic camera: F12 with nimbus and with Cycles."""
+    scene = bs.empty_scene(12, 12)
+    cam = bs.add_camera(scene, location=(0, 0.8, 5.0), target=(0, 0.8, 0), kind="ORTHO")
+    cam.data.ortho_scale = 1.6
+    data = bpy.data.volumes.new("Fire")
+    data.filepath = ARGS[2]
+    obj = bpy.data.objects.new("Fire", data)
+    scene.collection.objects.link(obj)
+    obj.data.materials.append(bs.node_material(
+        "Flame", "ShaderNodeVolumePrincipled", output="Volume", Density=0.0,
+        Blackbody_Intensity=1.0, Temperature=1.0, Temperature_Attribute="temperature"))
+    scene.world = None
+    scene.nimbus.spp = 64
+    export(os.path.join(OUT, "fire.json"))
+    path = os.path.join(OUT, "fire_nimbus.exr")
+    render(path)
+    scene.render.engine = "CYCLES"
+    scene.cycles.samples = 64
+    scene.cycles.use_denoising = False
+    cycles = os.path.join(OUT, "fire_cycles.exr")
+    render(cycles)
+    result["fire"] = {"nimbus": path, "cycles": cycles}
 
 
 def case_world():

@@ -136,6 +136,24 @@ def test_volume_emission_is_cycles(tmp_path):
         np.testing.assert_allclose(ours, cycles, rtol=0.003, err_msg=str(volume))
 
 
+def test_glowing_vdb_fire_is_cycles(tmp_path):
+    """A VDB flame that only emits, its blackbody from the temperature grid (emission per unit
+    length under the Stefan-Boltzmann law), against Cycles' render of it."""
+    vdb = os.path.join(SOURCE, "scenes", "vdb", "vdb_fire.vdb")
+    result, output = blender("fire", tmp_path, vdb)
+    document = json.loads((tmp_path / "fire.json").read_text())
+    glow = document["media"]["Fire"]["emission_per_length"]
+    assert glow["file"] == vdb and glow["grid"] == "temperature"
+    assert glow["law"] == "stefan-boltzmann" and glow["temperature_scale"] == 1
+    assert "left out" not in output
+    ours = nimbus.read_exr(result["fire"]["nimbus"]).mean(axis=(0, 1))
+    cycles = nimbus.read_exr(result["fire"]["cycles"]).mean(axis=(0, 1))
+    assert ours.max() > 0.01
+    # Cycles' blackbody colours are a fit (its blue is negative here), nimbus's Planck's law.
+    np.testing.assert_allclose(ours, cycles, rtol=0.05, atol=0.02 * cycles.max(),
+                               err_msg=str(result["fire"]))
+
+
 def test_world_colour_and_strength(tmp_path):
     result, output = blender("world", tmp_path)
     image = nimbus.read_exr(str(tmp_path / "world.exr"))

@@ -1,7 +1,9 @@
 #pragma once
 // A participating medium at run time: coefficients per unit length, a phase function and a
 // density (density.h). The medium at x is scale · density(x) · (sigma_a, sigma_s), emitting L_e:
-// a constant, or blackbody radiance at a temperature grid (temperature_emission.h).
+// a constant, or blackbody radiance at a temperature grid (temperature_emission.h). It may also
+// emit j per unit length wherever its object holds it, whatever mu_a and the density (Cycles'
+// volume emission; render/glow.h).
 
 #include <array>
 #include <memory>
@@ -27,7 +29,16 @@ struct Medium {
   double scale = 1;  // multiplies the density
   // Set: L_e at each point is this grid's, and `emission` is 0.
   std::shared_ptr<const TemperatureEmission> emission_grid;
+  // Radiance emitted per unit length, independent of sigma_a and the density: a constant, or
+  // this grid's L_e where it is set (`j` is then 0) (role Illuminant).
+  SpectralParam j;
+  std::shared_ptr<const TemperatureEmission> j_grid;
 };
+
+// Whether the medium emits per unit length (render/glow.h).
+inline bool glows(const Medium& m) {
+  return m.j_grid || largest_value(m.j) > 0;
+}
 
 // Whether the medium's density or textures read F, the holding object's function at the point.
 inline bool medium_uses_F(const Medium& m) {
@@ -46,6 +57,9 @@ struct MediumCoefficients {
   // Set (a temperature grid): L_e varies and is evaluated per point at the channels below;
   // `emission` is then 0. Null for every medium of constant emission, which costs a test.
   const TemperatureEmission* emission_grid = nullptr;
+  // Emission per unit length (Medium::j), a constant or, where j_grid is set, per point.
+  Spectrum<N> j{0.0};
+  const TemperatureEmission* j_grid = nullptr;
   bool spectral = false;           // the channels are wavelengths
   std::array<double, N> lambda{};  // their wavelengths (nm), in spectral mode
 };

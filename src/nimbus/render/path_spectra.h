@@ -98,7 +98,9 @@ void prepare_path_spectra(PathSpectra<N>& ps, const Scene& scene, double u) {
     if (c.sigma_s_texture) c.sigma_s_to = evaluate(med.sigma_s_to, ps.ch);
     c.emission = evaluate(med.emission, ps.ch);
     c.emission_grid = med.emission_grid.get();
-    if (c.emission_grid) {
+    c.j = evaluate(med.j, ps.ch);
+    c.j_grid = med.j_grid.get();
+    if (c.emission_grid || c.j_grid) {
       c.spectral = ps.ch.spectral;
       c.lambda = ps.ch.wl.lambda;
     }

@@ -198,14 +198,18 @@ double brightest_emission(const Scene& scene) {
     if (obj.medium < 0) continue;
     const Medium& m = scene.media[obj.medium];
     b = std::max(b, largest_value(m.emission));
-    if (m.emission_grid) {
-      // The hottest temperature the grid interpolates to inside the object, from the grid's own
-      // extrema (vdb_density.h); B's peak and its rgb both grow with the temperature.
-      const double kelvin = m.emission_grid->kelvin->range(obj.bounds, Interval::point(1.0)).hi;
-      if (kelvin >= kMinEmittingKelvin)
-        b = std::max(b, m.emission_grid->scale *
-                            std::max(planck_rgb(kelvin).max(), planck_spectrum(kelvin).scale));
-    }
+    // The hottest temperature a grid interpolates to inside the object, from the grid's own
+    // extrema (vdb_density.h).
+    auto hottest = [&](const TemperatureEmission& e) {
+      return e.kelvin_scale * e.kelvin->range(obj.bounds, Interval::point(1.0)).hi;
+    };
+    if (m.emission_grid)
+      b = std::max(b, brightest_temperature_emission(*m.emission_grid, hottest(*m.emission_grid)));
+    // Per unit length: at most j times the longest chord of the object's bounds.
+    const double chord = length(obj.bounds.extent());
+    b = std::max(b, largest_value(m.j) * chord);
+    if (m.j_grid)
+      b = std::max(b, brightest_temperature_emission(*m.j_grid, hottest(*m.j_grid)) * chord);
   }
   return b;
 }
@@ -232,6 +236,7 @@ void complete_spectra(Scene& scene) {
     complete_spectrum(m.sigma_a_to, SpectralRole::Unbounded);
     complete_spectrum(m.sigma_s_to, SpectralRole::Unbounded);
     complete_spectrum(m.emission, SpectralRole::Illuminant);
+    complete_spectrum(m.j, SpectralRole::Illuminant);
   }
   for (SceneObject& obj : scene.objects) {
     complete_spectrum(obj.surface.albedo, SpectralRole::Albedo);

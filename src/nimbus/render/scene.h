@@ -135,6 +135,8 @@ struct Scene {
   // The objects with emissive surfaces, which manifold sampling targets (render/emitter.h;
   // finish_scene).
   std::vector<int> emitters;
+  // The objects whose media emit per unit length (render/glow.h; finish_scene).
+  std::vector<int> glowing_objects;
   double scale = 1;  // size of the scene's bounds, for ray offsets
   // The exponent of its films (film.h: film_exponent of brightest_emission; finish_scene).
   int film_exponent = 0;

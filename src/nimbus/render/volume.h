@@ -11,6 +11,7 @@
 #include "nimbus/math/rng.h"
 #include "nimbus/media/medium_field.h"
 #include "nimbus/render/counters.h"
+#include "nimbus/render/glow.h"
 #include "nimbus/render/path_spectra.h"
 #include "nimbus/render/scene.h"
 #include "nimbus/tracking/decomposition_tracking.h"
@@ -76,9 +77,24 @@ struct RayLookup {
   const Ray& ray;
   int inside;
   MediumPoint<N> last;
+  // Where the scene glows (render/glow.h): the path weight the flights update, what the
+  // emission is added to, and the last point looked up. Each lookup is a tentative collision,
+  // made in order along the ray, before the flight reweights there: the weight holds over the
+  // interval since the last one.
+  Spectrum<N>* beta = nullptr;
+  Spectrum<N>* emitted = nullptr;
+  Rng* rng = nullptr;
+  double t_glow = 0;
   MediumSample<N> operator()(double t) {
+    if (beta) glow_to(t);
     medium_at(scene, ps.media, ray.at(t), inside, last);
     return as_sample(last);
+  }
+  // Scores the emission per unit length over (t_glow, t) at the current weight.
+  void glow_to(double t) {
+    glow_samples(scene, ps, ray, inside, t_glow, t, *rng,
+                 [&](double, const Spectrum<N>& len_j) { *emitted += *beta * len_j; });
+    t_glow = t;
   }
 };
 
@@ -123,7 +139,7 @@ struct WoodcockFlight {
     const Collision c =
         delta_tracking<N>(lookup, seg.t0, seg.t1, mu_bar, events.channel, rng, counters);
     if (c.event == CollisionEvent::Absorb)
-      emitted = beta * volume_detail::as_sample(lookup.last).L_e;
+      emitted += beta * volume_detail::as_sample(lookup.last).L_e;
     return c;
   }
 };
@@ -164,6 +180,12 @@ MediumEvent<N> sample_collision(const Scene& scene, const PathSpectra<N>& ps, co
   const bool one_channel = events.rule == EventRule::Channel;
   volume_detail::RayLookup<N> lookup{scene, ps, ray, inside, {}};
   Spectrum<N> emitted(0.0);
+  const bool glows = !scene.glowing_objects.empty();
+  if (glows) {
+    lookup.beta = &beta;
+    lookup.emitted = &emitted;
+    lookup.rng = &rng;
+  }
   MediumEvent<N> ev;
   walk_majorant_segments(scene, ps.ch, ray, 0, t_max, inside, [&](const MajorantSegment<N>& seg) {
     ++counters.majorant_segments;
@@ -183,6 +205,7 @@ MediumEvent<N> sample_collision(const Scene& scene, const PathSpectra<N>& ps, co
     ev = volume_detail::real_event(c, lookup.last, counters);
     return false;
   });
+  if (glows && ev.type == MediumEvent<N>::Type::None) lookup.glow_to(t_max);
   ev.emitted = emitted;
   return ev;
 }
@@ -196,16 +219,26 @@ MediumEvent<N> sample_collision_mis(const Scene& scene, const PathSpectra<N>& ps
   volume_detail::RayLookup<N> lookup{scene, ps, ray, inside, {}};
   Spectrum<N> emitted(0.0);
   MediumEvent<N> ev;
+  // Emission per unit length (render/glow.h) inside the segments by hero_tracking, and between
+  // them (no majorant: the path's weights hold) here.
+  auto glow = [&](double a, double b, auto&& f) {
+    glow_samples(scene, ps, ray, inside, a, b, rng, f);
+  };
+  double t_done = 0;  // where the last segment ended
   walk_majorant_segments(scene, ps.ch, ray, 0, t_max, inside, [&](const MajorantSegment<N>& seg) {
     ++counters.majorant_segments;
+    score_glow(glow, t_done, seg.t0, Spectrum<N>(0.0), hero, path, emitted);
+    t_done = seg.t1;
     const uint64_t raised = counters.tracking.raised;
     const Collision c = hero_tracking<N>(lookup, seg.t0, seg.t1, seg.mu_bar * boost, hero, path,
-                                         emitted, rng, counters.tracking);
+                                         emitted, rng, counters.tracking, glow);
     if (counters.tracking.raised != raised) boost *= kBoostOnRaise;
     if (c.event == CollisionEvent::Escape) return true;
     ev = volume_detail::real_event(c, lookup.last, counters);
     return false;
   });
+  if (ev.type == MediumEvent<N>::Type::None)
+    score_glow(glow, t_done, t_max, Spectrum<N>(0.0), hero, path, emitted);
   ev.emitted = emitted;
   return ev;
 }

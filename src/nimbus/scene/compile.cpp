@@ -90,6 +90,8 @@ Medium compile_medium(const MediumDesc& d, std::vector<InputFile>& inputs) {
   m.sigma_s_to = d.sigma_s_to;
   m.emission = d.emission;
   if (d.emission_grid) m.emission_grid = d.emission_grid(inputs);
+  m.j = d.j;
+  if (d.j_grid) m.j_grid = d.j_grid(inputs);
   m.g = d.phase.type == PhaseDesc::Type::HenyeyGreenstein ? d.phase.g : 0.0;
   m.density = d.density(inputs);
   m.scale = d.density_scale;
@@ -311,12 +313,15 @@ Scene compile_scene(const SceneDesc& desc, const BuildMonitor& monitor,
 
 void finish_scene(Scene& scene, const BuildMonitor& monitor) {
   scene.field_objects.clear();
+  scene.glowing_objects.clear();
   Box all;
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const SceneObject& obj = scene.objects[i];
     all = unite(all, obj.bounds);
     if (obj.surface.type == Surface::Type::None && obj.medium >= 0)
       scene.field_objects.push_back(static_cast<int>(i));
+    if (obj.medium >= 0 && glows(scene.media[size_t(obj.medium)]))
+      scene.glowing_objects.push_back(static_cast<int>(i));
   }
   std::vector<double> field_g;
   for (int i : scene.field_objects) {

@@ -382,6 +382,12 @@ class Loader {
       else
         m.emission = read_colour(*x, SpectralRole::Illuminant, kEmission);
     }
+    if (auto x = o.optional("emission_per_length")) {
+      if (is_emission_grid(*x))
+        m.j_grid = read_emission_grid(*x);
+      else
+        m.j = read_colour(*x, SpectralRole::Illuminant, kEmission);
+    }
     if (auto x = o.optional("phase")) {
       JsonObject p(*x);
       std::string type = "isotropic";

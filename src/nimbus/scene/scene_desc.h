@@ -59,6 +59,9 @@ struct MediumDesc {
   // Set: the emission is a temperature grid's (media/temperature_emission.h), read from its file
   // when the scene is compiled.
   Deferred<std::shared_ptr<const TemperatureEmission>> emission_grid;
+  // "emission_per_length": a colour, or a temperature grid as above.
+  SpectralParam j;
+  Deferred<std::shared_ptr<const TemperatureEmission>> j_grid;
   PhaseDesc phase;
   // How compile_scene makes the density (its type's reader, scene/density_types.h, checked the
   // keys; a "vdb" density's file is read then).

@@ -49,6 +49,16 @@ Rgb clamped(Rgb rgb) {
   return rgb;
 }
 
+// The table's luminance at T >= kTableKelvin and, if wanted, the chromaticity.
+double table_luminance(double kelvin, Rgb* chroma) {
+  const double x = 1 / kelvin / kTableStep;
+  const int i = std::min(static_cast<int>(x), kTableSteps - 1);
+  const double w = x - i;
+  const std::vector<Node>& t = table();
+  if (chroma) *chroma = t[i].chroma + (t[i + 1].chroma - t[i].chroma) * w;
+  return std::exp(t[i].log_yu + w * (t[i + 1].log_yu - t[i].log_yu)) * kelvin;
+}
+
 }  // namespace
 
 double planck_radiance(double lambda, double kelvin) {
@@ -69,13 +79,15 @@ SpectralCurve planck_spectrum(double kelvin) {
 Rgb planck_rgb(double kelvin) {
   if (!(kelvin > 0)) return Rgb(0.0);
   if (kelvin < kTableKelvin) return clamped(emission_to_rgb(planck_spectrum(kelvin)));
-  const double x = 1 / kelvin / kTableStep;
-  const int i = std::min(static_cast<int>(x), kTableSteps - 1);
-  const double w = x - i;
-  const std::vector<Node>& t = table();
-  const double log_yu = t[i].log_yu + w * (t[i + 1].log_yu - t[i].log_yu);
-  const Rgb chroma = t[i].chroma + (t[i + 1].chroma - t[i].chroma) * w;
-  return clamped(chroma * (std::exp(log_yu) * kelvin));
+  Rgb chroma;
+  const double y = table_luminance(kelvin, &chroma);
+  return clamped(chroma * y);
+}
+
+double planck_luminance(double kelvin) {
+  if (!(kelvin > 0)) return 0;
+  if (kelvin < kTableKelvin) return linear_srgb_to_xyz(emission_to_rgb(planck_spectrum(kelvin))).y;
+  return table_luminance(kelvin, nullptr);
 }
 
 }  // namespace nimbus

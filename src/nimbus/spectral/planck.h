@@ -29,4 +29,9 @@ SpectralCurve planck_spectrum(double kelvin);
 // over 1/T built once per process (about 0.1 s).
 Rgb planck_rgb(double kelvin);
 
+// The luminance of B(·, T) (that of planck_rgb before its clamp, in the units where RGB
+// (1, 1, 1) has luminance 1), from the same table: what divides B to give the
+// `{"blackbody": K}` colour of luminance 1. 0 for T <= 0.
+double planck_luminance(double kelvin);
+
 }  // namespace nimbus

@@ -15,6 +15,9 @@
 //   emission scored at every tentative collision: beta T_maj/pdf mu_a L_e / avg(r_u mu_maj
 //   T_maj/pdf)
 //            with pdf = T_maj[h] mu_maj[h]
+//   emission per unit length (render/glow.h) at a point u between tentative collisions, which
+//   the path reaches with probability T_maj[h] over Δt = u − t_prev:
+//            beta T_maj/T_maj[h] · len j / avg(r_u T_maj/T_maj[h])
 // with b = 1 where the channel's majorant bounds mu_t and mu_maj / (mu_a + mu_s + |mu_n|) where
 // it does not (failing_share). The hero's events are drawn with P_* = |mu_*[h]| b[h] / mu_maj[h]:
 // where the majorant bounds, P_a = mu_a/mu_maj, P_s = mu_s/mu_maj, P_n = mu_n/mu_maj; where it
@@ -76,17 +79,37 @@ void rescale_to_segment_end(MisPath<N>& path, const Spectrum<N>& mu_maj, int h, 
   path.r_l *= T_maj / T_maj[h];
 }
 
+// No emission per unit length.
+struct NoGlow {
+  template <class F>
+  void operator()(double, double, F&&) const {}
+};
+
+// Scores emission per unit length over (a, b) after the last tentative collision a, where the
+// majorants are maj (render/glow.h gives the samples: glow(a, b, f) calls f(u, len j)).
+template <int N, class Glow>
+void score_glow(Glow& glow, double a, double b, const Spectrum<N>& maj, int h,
+                const MisPath<N>& path, Spectrum<N>& emitted) {
+  glow(a, b, [&](double u, const Spectrum<N>& len_j) {
+    const Spectrum<N> T_maj = exp(maj * -(u - a));
+    const Spectrum<N> ratio = T_maj / T_maj[h];
+    const double r = (path.r_u * ratio).average();
+    if (r > 0) emitted += path.beta * ratio * len_j / r;
+  });
+}
+
 // Tracks [t0, t1] with hero channel h until a real collision or the segment's end; updates the
-// path and adds the weighted emission to `emitted`.
-template <int N, class Lookup>
+// path and adds the weighted emission to `emitted`, with that per unit length from `glow`.
+template <int N, class Lookup, class Glow = NoGlow>
 Collision hero_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>& mu_maj, int h,
                         MisPath<N>& path, Spectrum<N>& emitted, Rng& rng,
-                        TrackingCounters& counters) {
+                        TrackingCounters& counters, Glow&& glow = {}) {
   Collision c{CollisionEvent::Escape, t1};
   double t_prev = t0;        // the last tentative collision
   Spectrum<N> maj = mu_maj;  // raised where it fails (raise_majorants)
   const bool escaped = track_tentative_collisions(
       lookup, t0, t1, maj[h], rng, counters, [&](double t, const MediumSample<N>& m) {
+        score_glow(glow, t_prev, t, maj, h, path, emitted);
         const double dt = t - t_prev;
         t_prev = t;
         const Spectrum<N> T_maj = exp(maj * -dt);
@@ -130,7 +153,10 @@ Collision hero_tracking(Lookup&& lookup, double t0, double t1, const Spectrum<N>
         }
         return true;
       });
-  if (escaped) rescale_to_segment_end(path, maj, h, t1 - t_prev);
+  if (escaped) {
+    score_glow(glow, t_prev, t1, maj, h, path, emitted);
+    rescale_to_segment_end(path, maj, h, t1 - t_prev);
+  }
   return c;
 }
 
