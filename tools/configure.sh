@@ -21,10 +21,11 @@ case $kind in
     dir=${2:-build-sanitize}
     # Line tables are all that a sanitizer's report needs. Spectral mode is built for 4 and 8
     # wavelengths only (8 is the default): the counts share one template, and the Release build
-    # runs every count. No benchmarks.
+    # runs every count. No benchmarks. Batches of 16 sources (8 in Release, where an edit should
+    # recompile little): a tree that CI builds once (docs/testing.md).
     args=(-DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo
       "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -gline-tables-only -DNDEBUG"
-      -DNIMBUS_SANITIZE=ON -DNIMBUS_BUILD_FUZZER=ON -DNIMBUS_BUILD_BENCH=OFF
+      -DNIMBUS_SANITIZE=ON -DNIMBUS_BUILD_FUZZER=ON -DNIMBUS_BUILD_BENCH=OFF -DNIMBUS_UNITY_BATCH=16
       "-DNIMBUS_WAVELENGTH_COUNTS=4;8" -DPython3_EXECUTABLE=/usr/bin/python3)
     ;;
   *)

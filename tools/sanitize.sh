@@ -35,6 +35,9 @@ for family in WhiteFurnaceCloudDensityIndexMatched WhiteFurnaceBehindLosslessDie
   repeats+=":Modes/MediaRender.$family/Delta*:Modes/MediaRender.$family/SpectralHistoryCollide*"
 done
 repeats+=':FirstHit.AgreesWithBruteForceOnTheGallery'
+repeats+=':Modes/MediaRender.EmissionPerLengthFurnaceIsInEquilibrium/*Unbounded*'
+repeats+=':Modes/MediaRender.EmissionPerLengthFurnaceIsInEquilibrium/*Depth0'
+repeats+=':NoiseTarget.BlocksThatStopEarlyAreNeitherBrighterNorDarkerThanThoseThatRunLong'
 filter="*:-$repeats"
 [ "${1:-}" = "--all" ] && filter='*'
 sanitized_tests() { suites build-sanitize "$filter" -E "$never"; }
