@@ -38,11 +38,30 @@ repeats+=':FirstHit.AgreesWithBruteForceOnTheGallery'
 repeats+=':Modes/MediaRender.EmissionPerLengthFurnaceIsInEquilibrium/*Unbounded*'
 repeats+=':Modes/MediaRender.EmissionPerLengthFurnaceIsInEquilibrium/*Depth0'
 repeats+=':NoiseTarget.BlocksThatStopEarlyAreNeitherBrighterNorDarkerThanThoseThatRunLong'
+# Process-level repeats of paths that cheaper tests run under the sanitizers: resuming after a
+# kill (Checkpoints.Interrupted*), MPI (Mpi.RanksRenderToANoiseTarget*), the noise target's passes
+# (NoiseTarget.BlocksStop*), the sampling pass (the Sampled modes), the member grid's lookups
+# (ManyMedia's walks), compiling on many threads (every scene test compiles on them).
+repeats+=':Checkpoints.KilledAndResumedIsTheUninterruptedRender'
+repeats+=':Mpi.ARankKilledLeavesNoOutputAndTheCheckpointResumes'
+repeats+=':Job.ToANoiseTargetTheSameBitsInPassesInUnitsAndResumed'
+repeats+=':Octree.SamplingPassWorkIsBounded'
+repeats+=':ManyMedia.PointLookupsEqualTheLoopOverEveryObjectToTheBit'
+repeats+=':Scenes.ObjectsCompileTheSameOnOneThreadAsOnMany'
+# The render families under the sanitizers in the modes whose code differs: Woodcock's, the
+# weighted trackers' with decomposition (at both octree extremes, with failing and sampled
+# majorants), spectral MIS, and ray marching once. The rest run in the Release pass.
+for mode in SpectralHistoryWeightDepth4 SpectralHistoryWeightDecompositionDepth0 \
+  SpectralHistoryWeightDecompositionRayMarchingDepth4 \
+  SpectralHistoryWeightDecompositionUnboundedRayMarchingDepth4 'DeltaWeight*' \
+  'SpectralHistoryCollide*' 'DeltaCollideDecomposition*'; do
+  repeats+=":Modes/MediaRender.*/$mode:Modes/SpectralRender.*/$mode"
+done
 filter="*:-$repeats"
 [ "${1:-}" = "--all" ] && filter='*'
 sanitized_tests() { suites build-sanitize "$filter" -E "$never"; }
 phase "sanitized configure" bash tools/configure.sh sanitize
 phase "sanitized build" cmake --build build-sanitize -j"$(nproc)"
 phase "sanitized tests" sanitized_tests
-phase "fuzzing" bash tools/fuzz.sh --runs 200000 "$(nproc)"
-phase "fuzzing the file readers" bash tools/fuzz.sh --files --runs 40000 "$(nproc)"
+phase "fuzzing" bash tools/fuzz.sh --runs 100000 "$(nproc)"
+phase "fuzzing the file readers" bash tools/fuzz.sh --files --runs 20000 "$(nproc)"
