@@ -1,10 +1,10 @@
 #pragma once
 // Emission per unit length (a medium's "emission_per_length", Medium::j; docs/media.md,
-// "Emission"): the RTE's source term j, independent of mu_a and of the density, as Cycles' volume
-// emission is. A medium that emits sigma_a L_e is collected where the trackers collide; j may
-// glow where nothing collides (mu_t = 0), so it has an estimator of its own, the track length:
-// between two tentative collisions t_k < t_{k+1} of a free flight the path weight w_k is
-// constant, and w_k 1{the path is alive at t} estimates T(t) without bias at every t in between
+// "Emission per unit length"): the RTE's source term j, independent of mu_a and of the density, as
+// Cycles' volume emission is. A medium that emits sigma_a L_e is collected where the trackers
+// collide; j may glow where nothing collides (mu_t = 0), so it has an estimator of its own, the
+// track length: between two tentative collisions t_k < t_{k+1} of a free flight the path weight w_k
+// is constant, and w_k 1{the path is alive at t} estimates T(t) without bias at every t in between
 // (the product over a Poisson process of the null weights is ratio tracking's estimate), so
 //   Σ_k w_k ∫_{t_k}^{t_{k+1}} j(t) dt   estimates   ∫ T(t) j(t) dt,
 // and each interval's integral is estimated by one uniform point in it per glowing object whose
@@ -43,7 +43,7 @@ void glow_samples(const Scene& scene, const PathSpectra<N>& ps, const Ray& ray, 
   };
   if (inside >= 0) {
     const int m = scene.objects[size_t(inside)].medium;
-    if (m >= 0 && (ps.media[size_t(m)].j_grid || !ps.media[size_t(m)].j.is_black())) sample(inside);
+    if (m >= 0 && glows(scene.media[size_t(m)])) sample(inside);
     return;
   }
   for (int i : scene.glowing_objects)
