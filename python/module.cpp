@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -320,7 +321,8 @@ Film film_of(const PyScene& scene) {
 // film is claimed throughout (render/film.h): another thread's render_into or save of it
 // meanwhile is a ValueError, where both would have returned and one's samples been lost.
 void render_into_film(const PyScene& scene, Film& film, int s0, int s1,
-                      std::optional<uint64_t> seed, int threads, const py::object& progress) {
+                      std::array<int, 4> pixels, std::optional<uint64_t> seed, int threads,
+                      const py::object& progress) {
   const FilmClaim claim(film);
   const auto compiled = compiled_scene(scene, seed);
   if (film.width != compiled->settings.width || film.height != compiled->settings.height)
@@ -339,6 +341,10 @@ void render_into_film(const PyScene& scene, Film& film, int s0, int s1,
   options.threads = threads;
   options.range.s0 = s0;
   options.range.s1 = s1;
+  options.range.x0 = pixels[0];  // -1 for x1, y1: the image's edge
+  options.range.y0 = pixels[1];
+  options.range.x1 = pixels[2];
+  options.range.y1 = pixels[3];
   options.cancel = [&stop] { return stop.load(std::memory_order_relaxed); };
   options.progress = [&fraction](double f) { fraction.store(f, std::memory_order_relaxed); };
   run_interruptible([&](const std::atomic<bool>&) { render_into(*compiled, into, options); },
@@ -585,7 +591,7 @@ PYBIND11_MODULE(_core, m) {
         return "<nimbus.Film " + std::to_string(f.width) + "x" + std::to_string(f.height) + ">";
       });
   m.def("render_into", &np::render_into_film, py::arg("scene"), py::arg("film"), py::arg("s0"),
-        py::arg("s1"), py::arg("seed"), py::arg("threads"), py::arg("progress"));
+        py::arg("s1"), py::arg("pixels"), py::arg("seed"), py::arg("threads"), py::arg("progress"));
   py::class_<np::PyShape>(m, "Shape")
       .def(py::init(&np::make_shape), py::arg("shape"), py::arg("shapes"), py::arg("source"))
       .def("values", &np::shape_values, py::arg("points"))

@@ -111,13 +111,17 @@ def _progress(progress, total):
     raise TypeError("progress must be False, True or a callable (done, total)")
 
 
-def render_into(scene, film, samples, seed=None, threads=None, progress=False):
+def render_into(scene, film, samples, seed=None, threads=None, progress=False, pixels=None):
     """Adds the samples [s0, s1) of every pixel to `film` (nimbus.Film(scene)).
 
     Consecutive ranges, (0, 8) then (8, 16), give the bits of one render of 16 samples with
     the same seed. A stopped render (Ctrl-C: KeyboardInterrupt) leaves the film as it was. A film
     takes one render_into at a time: another thread's render_into or save of it meanwhile raises
     ValueError ("the film is already being rendered into ...").
+
+    pixels=(x0, y0, x1, y1) renders only the pixels x0 <= x < x1, y0 <= y < y1 (the others keep
+    what they hold); each pixel's samples are those of the whole image's render, so regions that
+    tile the image give its bits. With a noise target a region covers whole 8x8 blocks.
     """
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be a nimbus.Scene, not {type(scene).__name__}")
@@ -133,8 +137,21 @@ def render_into(scene, film, samples, seed=None, threads=None, progress=False):
         raise ValueError(f"samples must be a range s0 < s1, not ({s0}, {s1})")
     seed = _count("seed", seed, 0, 2**64 - 1)
     threads = _count("threads", threads, 1, 4096)
-    callback = _progress(progress, film.width * film.height * (s1 - s0))
-    _core.render_into(scene, film, s0, s1, seed, threads or 0, callback)
+    if pixels is None:
+        region = (0, 0, -1, -1)  # the whole image
+    else:
+        try:
+            x0, y0, x1, y1 = pixels
+        except (TypeError, ValueError):
+            raise TypeError("pixels must be a tuple (x0, y0, x1, y1) of pixel indices") from None
+        region = (_count("pixels[0]", x0, 0, film.width), _count("pixels[1]", y0, 0, film.height),
+                  _count("pixels[2]", x1, 0, film.width), _count("pixels[3]", y1, 0, film.height))
+        if x1 <= x0 or y1 <= y0:
+            raise ValueError(f"pixels must be a region x0 < x1, y0 < y1, not {tuple(pixels)}")
+    count = (film.width * film.height if pixels is None
+             else (region[2] - region[0]) * (region[3] - region[1]))
+    callback = _progress(progress, count * (s1 - s0))
+    _core.render_into(scene, film, s0, s1, region, seed, threads or 0, callback)
 
 
 def write_image(path, array):

@@ -194,6 +194,49 @@ def test_two_sample_ranges_give_one_renders_bits(tmp_path):
     assert np.array_equal(again.image(), whole) and again.spp == 6
 
 
+def test_regions_of_pixels_tile_one_renders_bits():
+    # pixels=(x0, y0, x1, y1): each pixel's samples are the whole render's, so regions that tile
+    # the image give its bits, and the pixels outside a region keep what they hold.
+    scene = nimbus.load_file(DEMO, SMALL)
+    whole = nimbus.render(scene, spp=4, seed=2)
+    film = nimbus.Film(scene)
+    nimbus.render_into(scene, film, samples=(0, 4), seed=2, pixels=(0, 0, 24, 5))
+    counts = film.samples()
+    assert (counts[:5] == 4).all() and (counts[5:] == 0).all() and film.spp == 0
+    assert np.array_equal(film.image()[:5], whole[:5]) and not film.image()[5:].any()
+    nimbus.render_into(scene, film, samples=(0, 4), seed=2, pixels=(0, 5, 7, 16))
+    nimbus.render_into(scene, film, samples=(0, 4), seed=2, pixels=(7, 5, 24, 16), threads=1)
+    assert film.spp == 4 and np.array_equal(film.image(), whole)
+    # With a noise target a region covers whole blocks, and its blocks decide as in the image.
+    target = nimbus.load_file(DEMO, {**SMALL, "integrator.noise_target": 0.05,
+                                     "integrator.spp": 128})
+    image = nimbus.render(target, spp=128, seed=3)
+    film = nimbus.Film(target)
+    nimbus.render_into(target, film, samples=(0, 128), seed=3, pixels=(0, 0, 8, 16))
+    nimbus.render_into(target, film, samples=(0, 128), seed=3, pixels=(8, 0, 24, 16))
+    assert np.array_equal(film.image(), image)
+    with pytest.raises(ValueError, match="must cover whole 8x8 blocks"):
+        nimbus.render_into(target, nimbus.Film(target), samples=(0, 16), pixels=(4, 0, 24, 16))
+
+
+def test_regions_of_pixels_are_checked():
+    scene = nimbus.load_file(DEMO, SMALL)
+    film = nimbus.Film(scene)
+    for pixels in [(0, 0, 25, 16), (-1, 0, 4, 4), (0, 0, 4, 17)]:
+        with pytest.raises(ValueError, match="pixels\\[[0-3]\\] must be in"):
+            nimbus.render_into(scene, film, samples=(0, 1), pixels=pixels)
+    for pixels in [(4, 0, 4, 4), (0, 6, 4, 2)]:
+        with pytest.raises(ValueError, match="x0 < x1, y0 < y1"):
+            nimbus.render_into(scene, film, samples=(0, 1), pixels=pixels)
+    for pixels in [(0, 0, 4), "abcd", 3, (0, 0, 4.0, 4)]:
+        with pytest.raises(TypeError):
+            nimbus.render_into(scene, film, samples=(0, 1), pixels=pixels)
+    nimbus.render_into(scene, film, samples=(0, 2), pixels=(0, 0, 4, 4))
+    with pytest.raises(ValueError, match="pixel \\(0, 0\\) holds 2 samples"):
+        nimbus.render_into(scene, film, samples=(0, 1), pixels=(0, 0, 8, 8))
+    assert film.samples()[:4, :4].min() == 2 and film.samples().sum() == 32
+
+
 def test_a_noise_target_renders_as_the_command_line_and_in_ranges(tmp_path):
     # Blocks of 8x8 pixels stop where their error meets the target (docs/noise-target.md): the
     # same pixels from render, from render_into in two ranges, and from nimbus render.
