@@ -64,11 +64,13 @@ DEFAULT_COUNT = ("spectral 8 (default)", ['spectrum.mode="spectral"', "spectrum.
 # --manifold-off: manifold next-event estimation turned off (issue 41; default on).
 MANIFOLD_OFF = ("spectral-mis, manifold off", ["integrator.manifold=false"])
 
+# --voxel-size, for the titles.
+VOXEL_SIZE = [1 / 64]
 # scene key -> (title, nimbus scene, pbrt scene); paths relative to OUT once staged.
 SCENES = {
-    "cloud": ("chromatic cloud (nimbus: its procedural density; pbrt: the 129³ grid)",
+    "cloud": ("chromatic cloud (nimbus: its procedural density; pbrt: the {grid} grid)",
               "chromatic_cloud.json", "chromatic_cloud.pbrt"),
-    "cloud-grid": ("chromatic cloud, the same 129³ grid in both",
+    "cloud-grid": ("chromatic cloud, the same {grid} grid in both",
                    "chromatic_cloud_vdb.json", "chromatic_cloud.pbrt"),
     "marble": ("marble sphere (SSS behind glass, IOR 1.5)", "marble.json", "marble.pbrt"),
     "skin": ("skin ellipsoid (SSS behind glass, IOR 1.3)", "skin.json", "skin.pbrt"),
@@ -163,6 +165,8 @@ def stage(ctx):
 
 def configs(scene_key, manifold_off=False):
     title, nscene, pscene = SCENES[scene_key]
+    # The cloud's grid spans the unit sphere's box [-1, 1]³ with a voxel at each end.
+    title = title.format(grid="%d³" % (round(2 / VOXEL_SIZE[0]) + 1))
     cs = [{"renderer": "pbrt", "label": "pbrt-v4", "spectrum": "spectral 4",
            "tracking": "spectral MIS (volpath)", "scene": pscene, "overrides": [],
            "ref_overrides": []}]
@@ -228,6 +232,7 @@ def main():
     for s in a.scenes:
         if s not in SCENES:
             sys.exit("unknown scene %r (known: %s)" % (s, ", ".join(SCENES)))
+    VOXEL_SIZE[0] = a.voxel_size
     ctx = Ctx(a)
     stage(ctx)
 
