@@ -75,26 +75,24 @@ def reference(args, scene, size):
     return mean, var
 
 
-def errors(image, ref, ref_var):
-    """(worst block's relative error, relative MSE), each less the reference's own."""
-    norm = np.maximum(np.abs(ref), FLOOR) ** 2
-    sq = ((image - ref) ** 2 - ref_var) / norm
-    h, w = sq.shape[:2]
-    worst = 0.0
-    for y in range(0, h, BLOCK):
-        for x in range(0, w, BLOCK):
-            worst = max(worst, float(sq[y:y + BLOCK, x:x + BLOCK].mean()))
-    return math.sqrt(max(worst, 0.0)), float(sq.mean())
+def relative_sq(image, ref, ref_var):
+    """Each pixel's and channel's squared relative error, less the reference's own."""
+    return ((image - ref) ** 2 - ref_var) / np.maximum(np.abs(ref), FLOOR) ** 2
 
 
 def block_errors(image, ref, ref_var):
     """Each 8x8 block's squared relative error (the rule's measure against the reference), as an
     array of (blocks down, blocks across)."""
-    norm = np.maximum(np.abs(ref), FLOOR) ** 2
-    sq = ((image - ref) ** 2 - ref_var) / norm
+    sq = relative_sq(image, ref, ref_var)
     h, w = sq.shape[:2]
     return np.array([[float(sq[y:y + BLOCK, x:x + BLOCK].mean()) for x in range(0, w, BLOCK)]
                      for y in range(0, h, BLOCK)])
+
+
+def errors(image, ref, ref_var):
+    """(worst block's relative error, relative MSE), each less the reference's own."""
+    worst = max(float(block_errors(image, ref, ref_var).max()), 0.0)
+    return math.sqrt(worst), float(relative_sq(image, ref, ref_var).mean())
 
 
 def block_costs(args, scene, size):
@@ -128,7 +126,7 @@ def oracle(args, scene, size, uniform, uniform_spp, worst, ref, ref_var):
     measured cost. Returns (ceiling, its mean spp, its cost per sample over uniform's)."""
     e2 = np.maximum(block_errors(uniform, ref, ref_var), 0.0)
     n = np.maximum(1.0, uniform_spp * e2 / worst ** 2)
-    n_max = max(float(n.max()), 1.0)
+    n_max = float(n.max())
     c = block_costs(args, scene, size)
     pixels = np.array([[min(BLOCK, size[0] - x) * min(BLOCK, size[1] - y)
                         for x in range(0, size[0], BLOCK)] for y in range(0, size[1], BLOCK)])
