@@ -3,9 +3,10 @@
 a figure of the three images with their noise against a 256-spp render (docs/python.md).
 
     PYTHONPATH=build/python /usr/bin/python3 examples/python/spp_figure.py [OUT.png]
+        [--size 96 72] [--reference-spp 256]
 """
+import argparse
 import os
-import sys
 
 import matplotlib
 
@@ -15,10 +16,16 @@ import numpy as np  # noqa: E402
 
 import nimbus  # noqa: E402
 
+parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+parser.add_argument("out", nargs="?", default="spp_figure.png")
+parser.add_argument("--size", type=int, nargs=2, default=(96, 72), metavar=("WIDTH", "HEIGHT"))
+parser.add_argument("--reference-spp", type=int, default=256)
+args = parser.parse_args()
+
 here = os.path.dirname(os.path.abspath(__file__))
 scene = nimbus.load_file(os.path.join(here, "..", "..", "scenes", "demo.json"),
-                         {"film.width": 96, "film.height": 72})
-reference = nimbus.render(scene, spp=256, seed=1)
+                         {"film.width": args.size[0], "film.height": args.size[1]})
+reference = nimbus.render(scene, spp=args.reference_spp, seed=1)
 counts = [4, 16, 64]
 figure, axes = plt.subplots(1, len(counts), figsize=(3.2 * len(counts), 2.8))
 for ax, spp in zip(axes, counts):
@@ -28,6 +35,5 @@ for ax, spp in zip(axes, counts):
     ax.set_title(f"{spp} spp, RMSE {rmse:.3f}")
     ax.axis("off")
 figure.tight_layout()
-out = sys.argv[1] if len(sys.argv) > 1 else "spp_figure.png"
-figure.savefig(out, dpi=100)
-print(out)
+figure.savefig(args.out, dpi=100)
+print(args.out)
