@@ -313,11 +313,12 @@ std::string RenderJob::summary(const JobOutcome& outcome) const {
   std::string spp = fmt::format("{} spp", s.spp);
   if (const NoiseRule rule = noise_rule(s); rule.on()) {
     const NoiseProgress p = noise_progress(rule, outcome.film);
+    const auto most = std::max_element(outcome.film.samples.begin(), outcome.film.samples.end());
     spp = fmt::format(
-        "noise target {:g}: {:.1f} spp on average, at most {}, {:.1f} % of pixels at "
+        "noise target {:g}: {:.1f} spp on average, {} at most (cap {}), {:.1f} % of pixels at "
         "the target",
-        rule.target, double(samples_held(outcome.film)) / outcome.film.pixels(), s.spp,
-        100 * (p.converged - p.capped));
+        rule.target, double(samples_held(outcome.film)) / outcome.film.pixels(),
+        most != outcome.film.samples.end() ? *most : 0u, s.spp, 100 * (p.converged - p.capped));
   }
   return fmt::format("{}x{}, {} in {:.2f} s ({:.3g} samples/s, {})", s.width, s.height, spp,
                      outcome.seconds, outcome.seconds > 0 ? samples / outcome.seconds : 0.0, where);
