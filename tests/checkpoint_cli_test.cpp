@@ -16,6 +16,7 @@
 
 #include "nimbus/job/checkpoint.h"
 #include "support/process.h"
+#include "support/sanitizer.h"
 
 namespace nimbus {
 namespace checkpoint_cli_test {
@@ -309,23 +310,24 @@ TEST_F(Checkpoints, ADamagedCheckpointIsNotResumed) {
   EXPECT_FALSE(fs::exists(dir_ / "b.exr"));
 }
 
-// A render of about 1.3 s (Release, one thread) with checkpoints into sub/, whose folder is
-// removed once the first checkpoint is there (as a full disk would fail them), then, with
-// `signal`, stopped 0.2 s later: the shell's report of its exit code, and its stderr. The removal
-// is repeated until the folder is gone: a checkpoint's temporary file created while `rm` empties
-// the folder keeps it (seen once in CI, on a loaded machine), and the render then saved its
-// checkpoint there.
+// A render of about 2 s (one thread: 1 000 spp in Release, 100 under AddressSanitizer, which runs
+// it about ten times slower; 1 000 there cost 26 s of the sanitized suite) with checkpoints into
+// sub/, whose folder is removed once the first checkpoint is there (as a full disk would fail
+// them), then, with `signal`, stopped 0.2 s later: the shell's report of its exit code, and its
+// stderr. The removal is repeated until the folder is gone: a checkpoint's temporary file created
+// while `rm` empties the folder keeps it (seen once in CI, on a loaded machine), and the render
+// then saved its checkpoint there.
 Ran render_losing_its_checkpoint_folder(const fs::path& dir, const std::string& signal) {
   const std::string nimbus = std::string("'") + NIMBUS_BINARY + "'";
   // One subshell, so that all of it runs in `dir`.
-  const Ran r =
-      run_in(dir, "(" + nimbus +
-                      " render scene.json -q --spp 1000 --threads 1 --checkpoint sub/ck.nck "
-                      "--checkpoint-interval 0.05 -o out.exr 2>render.err & pid=$!; "
-                      "for i in $(seq 6000); do [ -e sub/ck.nck ] && break; sleep 0.01; done; "
-                      "while [ -e sub ]; do rm -rf ./sub; done; " +
-                      (signal.empty() ? "" : "sleep 0.2; kill -" + signal + " $pid; ") +
-                      "wait $pid; echo $?)");
+  const Ran r = run_in(
+      dir,
+      "(" + nimbus + " render scene.json -q --spp " + (test::kAddressSanitizer ? "100" : "1000") +
+          " --threads 1 --checkpoint sub/ck.nck "
+          "--checkpoint-interval 0.05 -o out.exr 2>render.err & pid=$!; "
+          "for i in $(seq 6000); do [ -e sub/ck.nck ] && break; sleep 0.01; done; "
+          "while [ -e sub ]; do rm -rf ./sub; done; " +
+          (signal.empty() ? "" : "sleep 0.2; kill -" + signal + " $pid; ") + "wait $pid; echo $?)");
   return {std::stoi(r.out), file_bytes(dir / "render.err"), ""};
 }
 
