@@ -116,8 +116,7 @@ void RenderJob::check() const {
       throw JobError(fmt::format(
           "--resume {}: the checkpoint's film holds the sums of other AOVs than this render's",
           file));
-    const uint32_t most =
-        *std::max_element(resumed_->film.samples.begin(), resumed_->film.samples.end());
+    const uint32_t most = resumed_->film.most_samples();
     if (most > uint32_t(spp))
       throw JobError(
           fmt::format("--resume {}: pixels of the checkpoint hold {} samples, more than --spp {}",
@@ -313,12 +312,11 @@ std::string RenderJob::summary(const JobOutcome& outcome) const {
   std::string spp = fmt::format("{} spp", s.spp);
   if (const NoiseRule rule = noise_rule(s); rule.on()) {
     const NoiseProgress p = noise_progress(rule, outcome.film);
-    const auto most = std::max_element(outcome.film.samples.begin(), outcome.film.samples.end());
     spp = fmt::format(
         "noise target {:g}: {:.1f} spp on average, {} at most (cap {}), {:.1f} % of pixels at "
         "the target",
         rule.target, double(samples_held(outcome.film)) / outcome.film.pixels(),
-        most != outcome.film.samples.end() ? *most : 0u, s.spp, 100 * (p.converged - p.capped));
+        outcome.film.most_samples(), s.spp, 100 * (p.converged - p.capped));
   }
   return fmt::format("{}x{}, {} in {:.2f} s ({:.3g} samples/s, {})", s.width, s.height, spp,
                      outcome.seconds, outcome.seconds > 0 ? samples / outcome.seconds : 0.0, where);

@@ -9,6 +9,7 @@
 // same bits when each pixel's samples are added in sample order (one render, or a render that
 // continues where the film left off), and agree to rounding otherwise.
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -55,6 +56,10 @@ struct Film {
         samples(size_t(w) * h, 0),
         aov(aovs, size_t(w) * h, depth_exponent) {}
   int pixels() const { return width * height; }
+  // The most samples any pixel holds; 0 for a film without pixels.
+  uint32_t most_samples() const {
+    return samples.empty() ? 0u : *std::max_element(samples.begin(), samples.end());
+  }
   // The largest magnitude a sample may have: 2^(62 + exponent) (4.6e18 at exponent 0).
   double max_value() const { return std::ldexp(kExactSumMaxValue, exponent); }
   // Adds one sample. A value that is NaN or of magnitude max_value() or more in any channel

@@ -79,7 +79,6 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
                  {"sampled_points", sampled}};
   if (const NoiseRule rule = noise_rule(scene.settings); rule.on()) {
     const NoiseProgress p = noise_progress(rule, result.film);
-    const auto most = std::max_element(result.film.samples.begin(), result.film.samples.end());
     j["noise_target"] = {
         {"target", rule.target},
         {"min_spp", rule.min_spp},
@@ -87,7 +86,7 @@ nlohmann::json render_stats(const Scene& scene, const RenderResult& result,
         {"pixels_at_cap_above_target", p.capped},
         {"mean_spp", std::accumulate(result.film.samples.begin(), result.film.samples.end(), 0.0) /
                          std::max(1, result.film.pixels())},
-        {"max_spp", most != result.film.samples.end() ? *most : 0u}};
+        {"max_spp", result.film.most_samples()}};
   }
   return j;
 }
