@@ -17,7 +17,6 @@ over each ceiling's.
       [--films 8] [--spp 128] [--ref-spp 4096] [--out build-noisebench] [SCENE...]
 """
 import argparse
-import json
 import os
 import sys
 
@@ -44,10 +43,7 @@ def main():
     args = p.parse_args()
     import nimbus
     for scene in args.scenes:
-        with open(scene) as f:
-            film = json.load(f).get("film", {})
-        size = (max(BLOCK, round(film.get("width", 640) * args.scale)),
-                max(BLOCK, round(film.get("height", 480) * args.scale)))
+        size = nt.scene_size(scene, args.scale)
         ref, _ = nt.reference(args, scene, size)
         sc = nimbus.load_file(scene, {"film.width": size[0], "film.height": size[1]})
         films = np.array([nimbus.render(sc, spp=args.spp, seed=101 + k, threads=args.threads)

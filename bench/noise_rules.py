@@ -122,17 +122,12 @@ def main():
     p.add_argument("--cost-spp", type=int, default=64)
     p.add_argument("--out", default=os.path.join(nt.ROOT, "build-noisebench"))
     args = p.parse_args()
-    import json
-    with open(args.scene) as f:
-        film = json.load(f).get("film", {})
-    size = (max(BLOCK, round(film.get("width", 640) * args.scale)),
-            max(BLOCK, round(film.get("height", 480) * args.scale)))
+    size = nt.scene_size(args.scene, args.scale)
     ends = pass_ends(args.cap)
     ref, ref_var = nt.reference(args, args.scene, size)
     costs = nt.block_costs(args, args.scene, size)
     by, bx = costs.shape
-    pixels = np.array([[min(BLOCK, size[0] - x) * min(BLOCK, size[1] - y)
-                        for x in range(0, size[0], BLOCK)] for y in range(0, size[1], BLOCK)])
+    pixels = nt.block_pixels(size)
     print(f"{os.path.basename(args.scene)} {size[0]}x{size[1]}, pass ends up to {ends[-1]}")
     print("| seeds | target | rule | mean spp | worst block | blocks above 1.1 E | at the cap | "
           "uniform spp at that worst block | time saved |")

@@ -61,6 +61,21 @@ def render(args, scene, size, out, spp, seed, extra=()):
     return np.asarray(nimbus.read_exr(out), dtype=np.float64), st
 
 
+def scene_size(scene, scale):
+    """The scene file's film size times `scale`, at least a block each way."""
+    with open(scene) as f:
+        film = json.load(f).get("film", {})
+    return (max(BLOCK, round(film.get("width", 640) * scale)),
+            max(BLOCK, round(film.get("height", 480) * scale)))
+
+
+def block_pixels(size):
+    """The pixels of each 8x8 block of an image of `size`, cut at its edges, as (blocks down,
+    blocks across)."""
+    return np.array([[min(BLOCK, size[0] - x) * min(BLOCK, size[1] - y)
+                      for x in range(0, size[0], BLOCK)] for y in range(0, size[1], BLOCK)])
+
+
 def reference(args, scene, size):
     name = os.path.splitext(os.path.basename(scene))[0]
     base = os.path.join(args.out, "refs", f"{name}_{size[0]}x{size[1]}_{args.ref_spp}")
@@ -128,8 +143,7 @@ def oracle(args, scene, size, uniform, uniform_spp, worst, ref, ref_var):
     n = np.maximum(1.0, uniform_spp * e2 / worst ** 2)
     n_max = float(n.max())
     c = block_costs(args, scene, size)
-    pixels = np.array([[min(BLOCK, size[0] - x) * min(BLOCK, size[1] - y)
-                        for x in range(0, size[0], BLOCK)] for y in range(0, size[1], BLOCK)])
+    pixels = block_pixels(size)
     t_uniform = n_max * float((c * pixels).sum())
     t_oracle = float((c * pixels * n).sum())
     cost_ratio = float((c * pixels * n).sum() / (pixels * n).sum()) / float(
@@ -160,10 +174,7 @@ def main():
     os.makedirs(args.out, exist_ok=True)
     rows = []
     for scene in args.scenes:
-        with open(scene) as f:
-            film = json.load(f).get("film", {})
-        size = (max(BLOCK, round(film.get("width", 640) * args.scale)),
-                max(BLOCK, round(film.get("height", 480) * args.scale)))
+        size = scene_size(scene, args.scale)
         name = os.path.splitext(os.path.basename(scene))[0]
         ref, ref_var = reference(args, scene, size)
         _, setup = render(args, scene, size, os.path.join(args.out, name + "_setup.exr"), 1, 1)
